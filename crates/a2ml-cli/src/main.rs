@@ -1,0 +1,2 @@
+//! The `a2ml` command line.
+fn main() {}

@@ -1,0 +1,471 @@
+//! Inverse kinematics from CPSA and HAT states to joints (DESIGN.md §3).
+//!
+//! Arms whose shoulder axes meet in a point and whose wrist axes meet in a
+//! point are solved in closed form, elbow offsets allowed: the triangle
+//! S-E-W is rigid but for its angle at E, so |Pw| fixes q4 (Paden-Kahan
+//! subproblem 3), the shoulder's three axes realise the triangle's pose
+//! (subproblems 2 then 1) and the wrist's three axes realise Ow. Other arms
+//! use damped Newton on the square 7x7 task Jacobian.
+
+use super::error::{KinematicsError, Singularity};
+use super::fk::arm_pose;
+use super::spaces::{
+    CpsaState, HatState, cpsa_jacobian, cpsa_state, cpsa_to_hat, hat_jacobian, hat_points,
+    hat_state,
+};
+use crate::math::{
+    DOF, JointVector, Matrix3, Matrix7, PI, Real, Rotation3, Vector3, Vector7, reject,
+    rotation_about, rotation_log, solve_trig, wrap_angle,
+};
+use crate::robot::Robot;
+
+/// Settings of the numerical IK (arms without a closed form).
+#[derive(Debug, Clone)]
+pub struct IkOptions {
+    /// Starting points tried: `q_near` first, then a Halton sequence over the limits.
+    pub max_starts: usize,
+    /// Levenberg-Marquardt iterations per start.
+    pub max_iterations: usize,
+    /// Convergence threshold on the task-space residual norm.
+    pub tolerance: Real,
+    /// Slack allowed on joint limits (rad).
+    pub limit_tolerance: Real,
+}
+
+impl Default for IkOptions {
+    fn default() -> Self {
+        Self { max_starts: 64, max_iterations: 200, tolerance: 1e-12, limit_tolerance: 1e-9 }
+    }
+}
+
+/// Joint solutions reaching a CPSA state: every branch within the limits,
+/// nearest to `q_near` (default: the middle of the ranges) first. Newton
+/// arms return the one solution found from `q_near`.
+///
+/// # Errors
+/// [`KinematicsError::Unreachable`], [`KinematicsError::Singular`],
+/// [`KinematicsError::JointOutOfLimits`] (no branch within limits),
+/// [`KinematicsError::NoConvergence`] (Newton arms).
+pub fn ik_cpsa(
+    robot: &Robot,
+    target: &CpsaState,
+    q_near: Option<&JointVector>,
+) -> Result<Vec<JointVector>, KinematicsError> {
+    ik_cpsa_with(robot, target, q_near, &IkOptions::default())
+}
+
+/// [`ik_cpsa`] with explicit options.
+///
+/// # Errors
+/// As [`ik_cpsa`].
+pub fn ik_cpsa_with(
+    robot: &Robot,
+    target: &CpsaState,
+    q_near: Option<&JointVector>,
+    options: &IkOptions,
+) -> Result<Vec<JointVector>, KinematicsError> {
+    let hat = cpsa_to_hat(robot, target)?;
+    let near = q_near.copied().unwrap_or_else(|| robot.middle());
+    if robot.has_analytic_ik() {
+        let (elbow, wrist) = hat_points(robot, &hat);
+        let branches = analytic_branches(robot, &elbow, &wrist, &target.ow, &near)?;
+        return select(robot, branches, &near, options.limit_tolerance);
+    }
+    let (elbow, wrist) = hat_points(robot, &hat);
+    let guesses = decoupled_guesses(robot, &elbow, &wrist, &target.ow, &near);
+    newton(robot, &near, &guesses, options, |q| {
+        let pose = arm_pose(robot, q);
+        let state = cpsa_state(robot, &pose)?;
+        let mut e = Vector7::zeros();
+        e.fixed_rows_mut::<3>(0).copy_from(&(target.pw - state.pw));
+        e.fixed_rows_mut::<3>(3).copy_from(&rotation_log(&(target.ow * state.ow.inverse())));
+        e[6] = wrap_angle(target.swivel - state.swivel);
+        Ok((e, cpsa_jacobian(robot, &pose)?))
+    })
+}
+
+/// Joint solutions reaching a HAT state; as [`ik_cpsa`].
+///
+/// # Errors
+/// As [`ik_cpsa`].
+pub fn ik_hat(
+    robot: &Robot,
+    target: &HatState,
+    q_near: Option<&JointVector>,
+) -> Result<Vec<JointVector>, KinematicsError> {
+    ik_hat_with(robot, target, q_near, &IkOptions::default())
+}
+
+/// [`ik_hat`] with explicit options.
+///
+/// # Errors
+/// As [`ik_cpsa`].
+pub fn ik_hat_with(
+    robot: &Robot,
+    target: &HatState,
+    q_near: Option<&JointVector>,
+    options: &IkOptions,
+) -> Result<Vec<JointVector>, KinematicsError> {
+    if !(target.elbow_angle.is_finite() && target.shoulder_frame.matrix().iter().all(|v| v.is_finite())) {
+        return Err(KinematicsError::NonFinite { what: "HAT state" });
+    }
+    let near = q_near.copied().unwrap_or_else(|| robot.middle());
+    if robot.has_analytic_ik() {
+        let (elbow, wrist) = hat_points(robot, target);
+        let branches = analytic_branches(robot, &elbow, &wrist, &target.ow, &near)?;
+        return select(robot, branches, &near, options.limit_tolerance);
+    }
+    let (elbow, wrist) = hat_points(robot, target);
+    let guesses = decoupled_guesses(robot, &elbow, &wrist, &target.ow, &near);
+    newton(robot, &near, &guesses, options, |q| {
+        let pose = arm_pose(robot, q);
+        let state = hat_state(&pose)?;
+        let mut e = Vector7::zeros();
+        e.fixed_rows_mut::<3>(0)
+            .copy_from(&rotation_log(&(target.shoulder_frame * state.shoulder_frame.inverse())));
+        e[3] = target.elbow_angle - state.elbow_angle;
+        e.fixed_rows_mut::<3>(4).copy_from(&rotation_log(&(target.ow * state.ow.inverse())));
+        Ok((e, hat_jacobian(&pose)?))
+    })
+}
+
+/// Subproblem 1: the angle about unit `w` (through the origin) taking `u` towards `v`.
+fn rotation_angle(w: &Vector3, u: &Vector3, v: &Vector3) -> Option<Real> {
+    let (up, vp) = (reject(u, w), reject(v, w));
+    if up.norm() < 1e-12 || vp.norm() < 1e-12 {
+        return None;
+    }
+    Some(w.dot(&up.cross(&vp)).atan2(up.dot(&vp)))
+}
+
+/// Every (a, b, c) with `R = Rot(wa, a) Rot(wb, b) Rot(wc, c)`; where the
+/// first and last axes align (gimbal), `a` is taken from `near_a`.
+pub(crate) fn decompose(
+    r: &Matrix3,
+    wa: &Vector3,
+    wb: &Vector3,
+    wc: &Vector3,
+    near_a: Real,
+) -> Result<Vec<[Real; 3]>, KinematicsError> {
+    // Subproblem 2 on wc: Rot(wb, b) wc = Rot(wa, -a) (R wc) = c.
+    let (v, w) = (*wc, r * wc);
+    let k = wa.dot(wb);
+    let cross = wa.cross(wb);
+    if cross.norm() < 1e-9 {
+        return Err(KinematicsError::Singular(Singularity::ParallelAxes));
+    }
+    let alpha = (wa.dot(&w) - k * wb.dot(&v)) / (1.0 - k * k);
+    let beta = (wb.dot(&v) - k * wa.dot(&w)) / (1.0 - k * k);
+    let gamma_sq = (v.norm_squared() - alpha * alpha - beta * beta - 2.0 * alpha * beta * k)
+        / cross.norm_squared();
+    if gamma_sq < -1e-9 {
+        // The rotation is outside what these three axes can produce.
+        return Ok(Vec::new());
+    }
+    let gamma = gamma_sq.max(0.0).sqrt();
+    let gammas: &[Real] = if gamma < 1e-12 { &[0.0] } else { &[gamma, -gamma] };
+    let mut out = Vec::with_capacity(2);
+    for &g in gammas {
+        let c = alpha * wa + beta * wb + g * cross;
+        let b = rotation_angle(wb, &v, &c).unwrap_or(0.0);
+        let a = rotation_angle(wa, &c, &w).unwrap_or(near_a);
+        let rab = rotation_about(wa, a) * rotation_about(wb, b);
+        let rc = rab.transpose() * r;
+        // Any direction orthogonal to wc shows the last angle.
+        let probe = wc.cross(&if wc.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() });
+        let c_angle = rotation_angle(wc, &probe, &(rc * probe)).unwrap_or(0.0);
+        out.push([a, b, c_angle]);
+    }
+    Ok(out)
+}
+
+/// The rotation taking the pair (a0, b0) onto (a1, b1), which must have the
+/// same lengths and angle; `None` when they are parallel.
+fn align(a0: &Vector3, b0: &Vector3, a1: &Vector3, b1: &Vector3) -> Option<Matrix3> {
+    let frame = |a: &Vector3, b: &Vector3| {
+        let x = a.normalize();
+        let z = a.cross(b);
+        let zn = z.norm();
+        (zn > 1e-9 * a.norm() * b.norm()).then(|| {
+            let z = z / zn;
+            Matrix3::from_columns(&[x, z.cross(&x), z])
+        })
+    };
+    Some(frame(a1, b1)? * frame(a0, b0)?.transpose())
+}
+
+/// Every analytic branch reaching elbow E and wrist W (in {b}) with hand
+/// orientation Ow, angles moved by 2π into their ranges where possible.
+pub(crate) fn analytic_branches(
+    robot: &Robot,
+    elbow: &Vector3,
+    wrist: &Vector3,
+    ow: &Rotation3,
+    near: &JointVector,
+) -> Result<Vec<JointVector>, KinematicsError> {
+    branches_with_wrist(robot, &robot.structure.wrist_zero, elbow, wrist, ow, near)
+}
+
+/// [`analytic_branches`] for a wrist centre that sits at `wrist_zero` when
+/// joints 1-4 are at zero (exact when joints 5-7 do not move W).
+fn branches_with_wrist(
+    robot: &Robot,
+    wrist_zero: &Vector3,
+    elbow: &Vector3,
+    wrist: &Vector3,
+    ow: &Rotation3,
+    near: &JointVector,
+) -> Result<Vec<JointVector>, KinematicsError> {
+    let s = &robot.structure;
+    let (w, p) = (&s.axes_zero, &s.axis_points_zero);
+    let d = wrist.norm();
+
+    // q4: |p4 + Rot(w4, q4)(W0 - p4)| = |W|  (subproblem 3 about S = origin).
+    let v = wrist_zero - p[3];
+    let v_par = w[3] * w[3].dot(&v);
+    let v_perp = v - v_par;
+    let w_perp = w[3].cross(&v_perp);
+    let c0 = p[3] + v_par;
+    let q4s = solve_trig(
+        2.0 * c0.dot(&v_perp),
+        2.0 * c0.dot(&w_perp),
+        d * d - c0.norm_squared() - v_perp.norm_squared(),
+    );
+    if q4s.is_empty() {
+        let (lu, lf) = (robot.upper_arm_length(), robot.forearm_length());
+        return Err(KinematicsError::Unreachable { distance: d, min: (lu - lf).abs(), max: lu + lf });
+    }
+
+    let mut out = Vec::with_capacity(8);
+    for q4 in q4s {
+        let (s4, c4) = q4.sin_cos();
+        let wrist_moved = c0 + c4 * v_perp + s4 * w_perp;
+        let r123 = align(&s.elbow_zero, &wrist_moved, elbow, wrist)
+            .ok_or(KinematicsError::Singular(Singularity::StraightArm))?;
+        for [q1, q2, q3] in decompose(&r123, &w[0], &w[1], &w[2], near[0])? {
+            let r1234 = rotation_about(&w[0], q1)
+                * rotation_about(&w[1], q2)
+                * rotation_about(&w[2], q3)
+                * rotation_about(&w[3], q4);
+            let r567 = r1234.transpose() * ow.matrix() * s.hand_zero.matrix().transpose();
+            for [q5, q6, q7] in decompose(&r567, &w[4], &w[5], &w[6], near[4])? {
+                let q = JointVector::from_column_slice(&[q1, q2, q3, q4, q5, q6, q7]);
+                out.push(into_range(robot, q));
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Moves every angle by ±2π into its joint range where that is possible.
+fn into_range(robot: &Robot, mut q: JointVector) -> JointVector {
+    for (i, joint) in robot.joints.iter().enumerate() {
+        let l = &joint.limits;
+        let candidates = [q[i], q[i] - 2.0 * PI, q[i] + 2.0 * PI];
+        let excess = |v: Real| (l.lower - v).max(v - l.upper).max(0.0);
+        q[i] = candidates
+            .into_iter()
+            .min_by(|a, b| excess(*a).total_cmp(&excess(*b)))
+            .unwrap_or(q[i]);
+    }
+    q
+}
+
+fn limit_excess(robot: &Robot, q: &JointVector) -> (usize, Real) {
+    (0..DOF)
+        .map(|i| {
+            let l = &robot.joints[i].limits;
+            (i, (l.lower - q[i]).max(q[i] - l.upper))
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap_or((0, 0.0))
+}
+
+fn out_of_limits(robot: &Robot, q: &JointVector) -> KinematicsError {
+    let (i, excess) = limit_excess(robot, q);
+    let l = &robot.joints[i].limits;
+    KinematicsError::JointOutOfLimits {
+        joint: robot.joints[i].name.clone(),
+        value: q[i],
+        lower: l.lower,
+        upper: l.upper,
+        excess,
+    }
+}
+
+/// The distinct branches within limits, nearest `near` first.
+fn select(
+    robot: &Robot,
+    branches: Vec<JointVector>,
+    near: &JointVector,
+    tolerance: Real,
+) -> Result<Vec<JointVector>, KinematicsError> {
+    let mut inside: Vec<JointVector> = Vec::with_capacity(branches.len());
+    for q in branches.iter().filter(|q| robot.within_limits(q, tolerance)) {
+        if !inside.iter().any(|p| (p - q).amax() < 1e-9) {
+            inside.push(*q);
+        }
+    }
+    if inside.is_empty() {
+        let least = branches
+            .iter()
+            .min_by(|a, b| limit_excess(robot, a).1.total_cmp(&limit_excess(robot, b).1));
+        return Err(match least {
+            Some(q) => out_of_limits(robot, q),
+            None => KinematicsError::Singular(Singularity::ParallelAxes),
+        });
+    }
+    inside.sort_by(|a, b| (a - near).norm().total_cmp(&(b - near).norm()));
+    Ok(inside)
+}
+
+/// The k-th point of a Halton sequence, scaled into the joint limits.
+fn halton_start(robot: &Robot, k: usize) -> JointVector {
+    const BASES: [usize; DOF] = [2, 3, 5, 7, 11, 13, 17];
+    JointVector::from_fn(|i, _| {
+        let (mut f, mut r, mut n) = (1.0, 0.0, k + 1);
+        while n > 0 {
+            f /= BASES[i] as Real;
+            r += f * (n % BASES[i]) as Real;
+            n /= BASES[i];
+        }
+        let l = &robot.joints[i].limits;
+        l.lower + r * (l.upper - l.lower)
+    })
+}
+
+fn clamp_to_limits(robot: &Robot, q: &mut JointVector) {
+    for (i, joint) in robot.joints.iter().enumerate() {
+        q[i] = q[i].clamp(joint.limits.lower, joint.limits.upper);
+    }
+}
+
+/// A damped least-squares step that leaves joints resting on a limit alone
+/// when the step would push them further out, so that the free joints do
+/// the work instead of the step being clipped away.
+fn projected_step(
+    robot: &Robot,
+    q: &JointVector,
+    j: &Matrix7,
+    e: &Vector7,
+    lambda: Real,
+) -> Option<JointVector> {
+    let mut jac = *j;
+    let mut step = JointVector::zeros();
+    for _ in 0..DOF {
+        let jt = jac.transpose();
+        step = (jt * jac + Matrix7::identity() * lambda).cholesky()?.solve(&(jt * e));
+        let mut changed = false;
+        for (i, joint) in robot.joints.iter().enumerate() {
+            let l = &joint.limits;
+            let blocked = (q[i] <= l.lower && step[i] < 0.0) || (q[i] >= l.upper && step[i] > 0.0);
+            if blocked && jac.column(i).iter().any(|v| *v != 0.0) {
+                jac.column_mut(i).fill(0.0);
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    Some(step)
+}
+
+/// Starting points for Newton on an arm whose wrist centre moves with
+/// joints 5-6 (the human arm): freeze those joints, solve the rest in
+/// closed form, re-freeze at the answer, a few times over, from every
+/// branch. Empty when the shoulder is not spherical.
+fn decoupled_guesses(
+    robot: &Robot,
+    elbow: &Vector3,
+    wrist: &Vector3,
+    ow: &Rotation3,
+    near: &JointVector,
+) -> Vec<JointVector> {
+    let s = &robot.structure;
+    if !s.shoulder_spherical {
+        return Vec::new();
+    }
+    let (w, p) = (&s.axes_zero, &s.axis_points_zero);
+    let about = |i: usize, angle: Real, x: &Vector3| p[i] + rotation_about(&w[i], angle) * (x - p[i]);
+    let wrist_zero = |q: &JointVector| about(4, q[4], &about(5, q[5], &s.wrist_zero));
+    let solve = |q: &JointVector| branches_with_wrist(robot, &wrist_zero(q), elbow, wrist, ow, q);
+    let Ok(branches) = solve(near) else { return Vec::new() };
+    let mut guesses: Vec<JointVector> = branches
+        .into_iter()
+        .map(|mut q| {
+            for _ in 0..4 {
+                let Some(next) = solve(&q).ok().and_then(|b| {
+                    b.into_iter().min_by(|a, c| (a - q).norm().total_cmp(&(c - q).norm()))
+                }) else {
+                    break;
+                };
+                q = next;
+            }
+            q
+        })
+        .collect();
+    // Within limits first, then nearest.
+    guesses.sort_by(|a, b| {
+        let key = |q: &JointVector| (limit_excess(robot, q).1.max(0.0), (q - near).norm());
+        key(a).partial_cmp(&key(b)).unwrap_or(std::cmp::Ordering::Equal)
+    });
+    guesses
+}
+
+/// Levenberg-Marquardt on a square task Jacobian, kept inside the joint
+/// limits, from the guesses, `near` and then Halton starts.
+fn newton<F>(
+    robot: &Robot,
+    near: &JointVector,
+    guesses: &[JointVector],
+    options: &IkOptions,
+    residual: F,
+) -> Result<Vec<JointVector>, KinematicsError>
+where
+    F: Fn(&JointVector) -> Result<(Vector7, Matrix7), KinematicsError>,
+{
+    if !near.iter().all(|v| v.is_finite()) {
+        return Err(KinematicsError::NonFinite { what: "q_near" });
+    }
+    let mut best = Real::INFINITY;
+    let starts = guesses
+        .iter()
+        .copied()
+        .chain(std::iter::once(*near))
+        .chain((1..).map(|k| halton_start(robot, k)))
+        .take(options.max_starts.max(guesses.len() + 1));
+    for mut q in starts {
+        clamp_to_limits(robot, &mut q);
+        let Ok((mut e, mut j)) = residual(&q) else { continue };
+        let mut lambda = 1e-6;
+        for _ in 0..options.max_iterations {
+            if e.norm() < options.tolerance {
+                break;
+            }
+            let Some(step) = projected_step(robot, &q, &j, &e, lambda) else {
+                lambda *= 10.0;
+                continue;
+            };
+            let mut trial = q + step;
+            clamp_to_limits(robot, &mut trial);
+            match residual(&trial) {
+                Ok((e2, j2)) if e2.norm() < e.norm() => {
+                    (q, e, j) = (trial, e2, j2);
+                    lambda = (lambda * 0.1).max(1e-12);
+                }
+                _ => {
+                    lambda *= 10.0;
+                    if lambda > 1e6 {
+                        break;
+                    }
+                }
+            }
+        }
+        best = best.min(e.norm());
+        if e.norm() < options.tolerance.max(1e-10) {
+            return Ok(vec![q]);
+        }
+    }
+    Err(KinematicsError::NoConvergence { residual: best, starts: options.max_starts })
+}

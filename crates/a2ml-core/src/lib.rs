@@ -1,0 +1,15 @@
+//! a2ml: plans human-like motions for 7-DoF anthropomorphic arms from tasks
+//! written in A2ML (Fang & Ding 2019).
+//!
+//! The modules follow the pipeline: [`robot`] (URDF to an arm model) then
+//! [`kinematics`] (FK, CPSA and HAT states, Jacobians, IK).
+
+pub mod error;
+pub mod kinematics;
+pub mod math;
+pub mod robot;
+
+pub use error::Error;
+pub use kinematics::{CpsaState, HatState, KinematicsError};
+pub use math::{JointVector, Real};
+pub use robot::{Robot, RobotError, RobotOptions};

@@ -1,0 +1,104 @@
+use crate::math::Real;
+
+/// Why a URDF could not become a [`super::Robot`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RobotError {
+    /// The file does not exist.
+    #[error("URDF file not found: {path}")]
+    FileMissing {
+        /// The path as given.
+        path: String,
+    },
+    /// The file exists but cannot be read.
+    #[error("cannot read {path}: {message}")]
+    Io {
+        /// The path as given.
+        path: String,
+        /// The OS message.
+        message: String,
+    },
+    /// The document is not valid URDF.
+    #[error("{}invalid URDF: {message}", path.as_deref().map(|p| format!("{p}: ")).unwrap_or_default())]
+    Urdf {
+        /// The file, when read from one.
+        path: Option<String>,
+        /// The parser's message.
+        message: String,
+    },
+    /// A link named by the user is not in the URDF.
+    #[error("no link named `{name}`{}", did_you_mean.as_deref().map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default())]
+    UnknownLink {
+        /// The name asked for.
+        name: String,
+        /// The closest existing link name.
+        did_you_mean: Option<String>,
+    },
+    /// The chain between base and tip does not have 7 revolute joints.
+    #[error("the chain {base} -> {tip} has {found} revolute joints ({joints}); an anthropomorphic arm needs 7")]
+    NotSevenDof {
+        /// Base link.
+        base: String,
+        /// Tip link.
+        tip: String,
+        /// Number of revolute joints found.
+        found: usize,
+        /// Their names, comma separated.
+        joints: String,
+    },
+    /// No chain of the tree has 7 revolute joints.
+    #[error("no chain of 7 revolute joints in the URDF (longest has {longest})")]
+    NoSevenDofChain {
+        /// Revolute joints on the longest chain.
+        longest: usize,
+    },
+    /// Several different 7-joint chains: base and tip must be given.
+    #[error("several 7-joint chains (tips: {tips}); choose one with a tip link")]
+    AmbiguousChain {
+        /// Candidate tip links, comma separated.
+        tips: String,
+    },
+    /// A joint type that an arm chain cannot contain.
+    #[error("joint `{joint}` is {kind}; an arm chain holds revolute and fixed joints only")]
+    UnsupportedJoint {
+        /// Joint name.
+        joint: String,
+        /// Its URDF type.
+        kind: String,
+    },
+    /// A revolute joint without usable limits.
+    #[error("joint `{joint}` has no usable limits (lower {lower}, upper {upper}, velocity {velocity})")]
+    JointWithoutLimits {
+        /// Joint name.
+        joint: String,
+        /// Lower limit read.
+        lower: Real,
+        /// Upper limit read.
+        upper: Real,
+        /// Velocity limit read.
+        velocity: Real,
+    },
+    /// The geometry is not that of a shoulder-elbow-wrist arm.
+    #[error("not an anthropomorphic arm: {reason}")]
+    NotAnthropomorphic {
+        /// What is wrong.
+        reason: String,
+    },
+    /// Bad tool or vertical axes in the options.
+    #[error("invalid option: {reason}")]
+    InvalidOption {
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+impl RobotError {
+    /// Adds the file path to errors that came from parsing its text.
+    pub(crate) fn in_file(self, path: &std::path::Path) -> Self {
+        match self {
+            Self::Urdf { path: None, message } => {
+                Self::Urdf { path: Some(path.display().to_string()), message }
+            }
+            other => other,
+        }
+    }
+}

@@ -1,0 +1,8 @@
+//! Integration tests of the a2ml library, one module per area.
+
+mod common;
+mod errors;
+mod ik;
+mod jacobians;
+mod robots;
+mod swivel;
