@@ -72,8 +72,8 @@ pub fn ik_cpsa_with(
         return select(robot, branches, &near, options.limit_tolerance);
     }
     let (elbow, wrist) = hat_points(robot, &hat);
-    let guesses = decoupled_guesses(robot, &elbow, &wrist, &target.ow, &near);
-    newton(robot, &near, &guesses, options, |q| {
+    let guesses = || decoupled_guesses(robot, &elbow, &wrist, &target.ow, &near);
+    newton(robot, &near, q_near.is_some(), guesses, options, |q| {
         let pose = arm_pose(robot, q);
         let state = cpsa_state(robot, &pose)?;
         let mut e = Vector7::zeros();
@@ -116,8 +116,8 @@ pub fn ik_hat_with(
         return select(robot, branches, &near, options.limit_tolerance);
     }
     let (elbow, wrist) = hat_points(robot, target);
-    let guesses = decoupled_guesses(robot, &elbow, &wrist, &target.ow, &near);
-    newton(robot, &near, &guesses, options, |q| {
+    let guesses = || decoupled_guesses(robot, &elbow, &wrist, &target.ow, &near);
+    newton(robot, &near, q_near.is_some(), guesses, options, |q| {
         let pose = arm_pose(robot, q);
         let state = hat_state(&pose)?;
         let mut e = Vector7::zeros();
@@ -414,27 +414,34 @@ fn decoupled_guesses(
 }
 
 /// Levenberg-Marquardt on a square task Jacobian, kept inside the joint
-/// limits, from the guesses, `near` and then Halton starts.
-fn newton<F>(
+/// limits, from `near` and the closed-form guesses (in the order the caller
+/// prefers), then Halton starts.
+fn newton<F, G>(
     robot: &Robot,
     near: &JointVector,
-    guesses: &[JointVector],
+    near_first: bool,
+    guesses: G,
     options: &IkOptions,
     residual: F,
 ) -> Result<Vec<JointVector>, KinematicsError>
 where
     F: Fn(&JointVector) -> Result<(Vector7, Matrix7), KinematicsError>,
+    G: FnOnce() -> Vec<JointVector>,
 {
     if !near.iter().all(|v| v.is_finite()) {
         return Err(KinematicsError::NonFinite { what: "q_near" });
     }
     let mut best = Real::INFINITY;
-    let starts = guesses
-        .iter()
-        .copied()
-        .chain(std::iter::once(*near))
+    // A caller's q_near is usually close: try it before paying for guesses.
+    let near_start = std::iter::once(*near);
+    let (before, after) = if near_first { (Some(near_start), None) } else { (None, Some(near_start)) };
+    let starts = before
+        .into_iter()
+        .flatten()
+        .chain(std::iter::once_with(guesses).flatten())
+        .chain(after.into_iter().flatten())
         .chain((1..).map(|k| halton_start(robot, k)))
-        .take(options.max_starts.max(guesses.len() + 1));
+        .take(options.max_starts);
     for mut q in starts {
         clamp_to_limits(robot, &mut q);
         let Ok((mut e, mut j)) = residual(&q) else { continue };

@@ -8,14 +8,13 @@
 //! `A cos θ + B sin θ + C`. A joint of a three-axis group sits at a limit L
 //! exactly when one scalar `uᵀ R(θ) v` equals a constant, so every limit
 //! crossing is a root of `a cos θ + b sin θ = c`. Between consecutive roots
-//! feasibility cannot change; one IK at each piece's midpoint decides it.
+//! feasibility cannot change; one decomposition at each piece's midpoint
+//! decides it, per group, since q4 does not depend on θ.
 
 use super::error::KinematicsError;
-use super::ik::analytic_branches;
+use super::ik::{analytic_branches, decompose};
 use super::spaces::{CpsaState, cpsa_to_hat, hat_points};
-use crate::math::{
-    DOF, Matrix3, PI, Real, Rotation3, Vector3, projector, rotation_about, skew, solve_trig,
-};
+use crate::math::{Matrix3, PI, Real, Rotation3, Vector3, projector, rotation_about, skew, solve_trig};
 use crate::robot::Robot;
 
 /// A closed interval of swivel angles [lower, upper] within [-π, π] (rad).
@@ -41,29 +40,106 @@ struct TrigMatrix {
     c: Matrix3,
 }
 
+/// One three-axis joint group (shoulder 1-3 or wrist 5-7) whose rotation
+/// turns with θsw.
+struct Group<'a> {
+    rotation: TrigMatrix,
+    axes: [&'a Vector3; 3],
+    limits: [(Real, Real); 3],
+}
+
 impl TrigMatrix {
+    fn at(&self, theta: Real) -> Matrix3 {
+        let (s, c) = theta.sin_cos();
+        self.a * c + self.b * s + self.c
+    }
+
     /// The θ where `uᵀ R(θ) v = k`.
     fn roots(&self, u: &Vector3, v: &Vector3, k: Real) -> Vec<Real> {
         let f = |m: &Matrix3| u.dot(&(m * v));
         solve_trig(f(&self.a), f(&self.b), k - f(&self.c))
     }
+}
 
-    /// The θ where one joint of the group about axes `w` reaches a limit.
-    fn limit_roots(&self, w: [&Vector3; 3], limits: [(Real, Real); 3], out: &mut Vec<Real>) {
-        let [wa, wb, wc] = w;
-        for (i, (lower, upper)) in limits.into_iter().enumerate() {
+/// Whether `v` or `v ± 2π` lies in [lower, upper].
+fn angle_within((lower, upper): (Real, Real), v: Real) -> bool {
+    [v, v - 2.0 * PI, v + 2.0 * PI].iter().any(|x| *x >= lower && *x <= upper)
+}
+
+impl Group<'_> {
+    /// Every θ where one joint of the group reaches a limit.
+    fn limit_roots(&self) -> Vec<Real> {
+        let [wa, wb, wc] = self.axes;
+        let mut out = Vec::new();
+        for (i, (lower, upper)) in self.limits.into_iter().enumerate() {
             if upper - lower >= 2.0 * PI {
                 continue;
             }
             for limit in [lower, upper] {
+                let r = &self.rotation;
                 out.extend(match i {
-                    0 => self.roots(&(rotation_about(wa, limit) * wb), wc, wb.dot(wc)),
-                    1 => self.roots(wa, wc, wa.dot(&(rotation_about(wb, limit) * wc))),
-                    _ => self.roots(wa, &(rotation_about(wc, -limit) * wb), wa.dot(wb)),
+                    // R = Ra Rb Rc: fixing one angle leaves one scalar of R fixed.
+                    0 => r.roots(&(rotation_about(wa, limit) * wb), wc, wb.dot(wc)),
+                    1 => r.roots(wa, wc, wa.dot(&(rotation_about(wb, limit) * wc))),
+                    _ => r.roots(wa, &(rotation_about(wc, -limit) * wb), wa.dot(wb)),
                 });
             }
         }
+        out
     }
+
+    /// Whether some solution of the group at θ lies within its limits.
+    fn feasible_at(&self, theta: Real, near_a: Real) -> bool {
+        let [wa, wb, wc] = self.axes;
+        decompose(&self.rotation.at(theta), wa, wb, wc, near_a)
+            .map(|sols| sols.iter().any(|s| (0..3).all(|i| angle_within(self.limits[i], s[i]))))
+            .unwrap_or(false)
+    }
+
+    /// The feasible θ as sorted disjoint intervals of [-π, π].
+    fn feasible(&self, near_a: Real) -> Vec<SwivelInterval> {
+        let mut cuts = self.limit_roots();
+        cuts.extend([-PI, PI]);
+        cuts.sort_by(Real::total_cmp);
+        cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+        let mut out: Vec<SwivelInterval> = Vec::new();
+        for pair in cuts.windows(2) {
+            let (lower, upper) = (pair[0], pair[1]);
+            if !self.feasible_at(0.5 * (lower + upper), near_a) {
+                continue;
+            }
+            match out.last_mut() {
+                Some(last) if (last.upper - lower).abs() < 1e-12 => last.upper = upper,
+                _ => out.push(SwivelInterval { lower, upper }),
+            }
+        }
+        out
+    }
+}
+
+fn intersect(a: &[SwivelInterval], b: &[SwivelInterval]) -> Vec<SwivelInterval> {
+    let mut out = Vec::new();
+    for x in a {
+        for y in b {
+            let (lower, upper) = (x.lower.max(y.lower), x.upper.min(y.upper));
+            if lower < upper {
+                out.push(SwivelInterval { lower, upper });
+            }
+        }
+    }
+    out
+}
+
+fn union(mut all: Vec<SwivelInterval>) -> Vec<SwivelInterval> {
+    all.sort_by(|a, b| a.lower.total_cmp(&b.lower));
+    let mut out: Vec<SwivelInterval> = Vec::with_capacity(all.len());
+    for i in all {
+        match out.last_mut() {
+            Some(last) if i.lower <= last.upper + 1e-12 => last.upper = last.upper.max(i.upper),
+            _ => out.push(i),
+        }
+    }
+    out
 }
 
 /// The swivel angles for which some IK branch reaching (Pw, Ow) lies within
@@ -71,8 +147,8 @@ impl TrigMatrix {
 /// through ±π appears as two pieces).
 ///
 /// # Errors
-/// [`KinematicsError::NotAnalytic`] unless shoulder and wrist are
-/// spherical; [`KinematicsError::Unreachable`]; the wrist above the shoulder.
+/// [`KinematicsError::NotAnalytic`] unless the arm has analytic IK;
+/// [`KinematicsError::Unreachable`]; the wrist above the shoulder.
 pub fn swivel_intervals(
     robot: &Robot,
     pw: &Vector3,
@@ -84,49 +160,43 @@ pub fn swivel_intervals(
     let s = &robot.structure;
     let w = &s.axes_zero;
     let limit = |i: usize| (robot.joints[i].limits.lower, robot.joints[i].limits.upper);
-    let near = robot.middle();
-    let points_at = |theta: Real| -> Result<(Vector3, Vector3), KinematicsError> {
-        let hat = cpsa_to_hat(robot, &CpsaState { pw: *pw, ow: *ow, swivel: theta })?;
-        Ok(hat_points(robot, &hat))
-    };
-    let (elbow0, wrist) = points_at(0.0)?;
+    let hat = cpsa_to_hat(robot, &CpsaState { pw: *pw, ow: *ow, swivel: 0.0 })?;
+    let (elbow0, wrist) = hat_points(robot, &hat);
     let x = wrist.normalize();
     let xx = x * x.transpose();
     let hand = ow.matrix() * s.hand_zero.matrix().transpose();
+    let near = robot.middle();
 
-    let mut roots = Vec::new();
-    // Every q4 branch: its elbow-triangle rotation R123(0) and wrist group.
+    // The shoulder and wrist groups are independent once q4 is fixed (it
+    // does not depend on θ), so each q4 branch contributes the intersection
+    // of the two groups' feasible sets.
+    let mut feasible = Vec::new();
+    let mut seen_q4: Vec<Real> = Vec::new();
     for q in analytic_branches(robot, &elbow0, &wrist, ow, &near)? {
-        let r0 = rotation_about(&w[0], q[0]) * rotation_about(&w[1], q[1]) * rotation_about(&w[2], q[2]);
-        let shoulder = TrigMatrix { a: projector(&x) * r0, b: -skew(&x) * r0, c: xx * r0 };
-        shoulder.limit_roots([&w[0], &w[1], &w[2]], [limit(0), limit(1), limit(2)], &mut roots);
-        let r1234t = (r0 * rotation_about(&w[3], q[3])).transpose();
-        let wrist_group =
-            TrigMatrix { a: r1234t * projector(&x) * hand, b: r1234t * skew(&x) * hand, c: r1234t * xx * hand };
-        wrist_group.limit_roots([&w[4], &w[5], &w[6]], [limit(4), limit(5), limit(6)], &mut roots);
-    }
-    roots.extend([-PI, PI]);
-    roots.sort_by(Real::total_cmp);
-    roots.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
-
-    let feasible = |theta: Real| {
-        points_at(theta)
-            .and_then(|(e, w)| analytic_branches(robot, &e, &w, ow, &near))
-            .map(|branches| branches.iter().any(|q| robot.within_limits(q, 0.0)))
-            .unwrap_or(false)
-    };
-    let mut intervals: Vec<SwivelInterval> = Vec::new();
-    for pair in roots.windows(2) {
-        let (lower, upper) = (pair[0], pair[1]);
-        if !feasible(0.5 * (lower + upper)) {
+        if seen_q4.iter().any(|q4| (q4 - q[3]).abs() < 1e-12) {
             continue;
         }
-        match intervals.last_mut() {
-            Some(last) if (last.upper - lower).abs() < 1e-12 => last.upper = upper,
-            _ => intervals.push(SwivelInterval { lower, upper }),
+        seen_q4.push(q[3]);
+        if !angle_within(limit(3), q[3]) {
+            continue;
         }
+        let r0 = rotation_about(&w[0], q[0]) * rotation_about(&w[1], q[1]) * rotation_about(&w[2], q[2]);
+        let shoulder = Group {
+            rotation: TrigMatrix { a: projector(&x) * r0, b: -skew(&x) * r0, c: xx * r0 },
+            axes: [&w[0], &w[1], &w[2]],
+            limits: [limit(0), limit(1), limit(2)],
+        };
+        let r1234t = (r0 * rotation_about(&w[3], q[3])).transpose();
+        let wrist_group = Group {
+            rotation: TrigMatrix {
+                a: r1234t * projector(&x) * hand,
+                b: r1234t * skew(&x) * hand,
+                c: r1234t * xx * hand,
+            },
+            axes: [&w[4], &w[5], &w[6]],
+            limits: [limit(4), limit(5), limit(6)],
+        };
+        feasible.extend(intersect(&shoulder.feasible(near[0]), &wrist_group.feasible(near[4])));
     }
-    debug_assert!(intervals.iter().all(|i| i.lower <= i.upper && i.upper - i.lower <= 2.0 * PI + 1e-9));
-    let _ = DOF;
-    Ok(intervals)
+    Ok(union(feasible))
 }
