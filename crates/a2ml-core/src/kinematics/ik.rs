@@ -206,16 +206,14 @@ pub(crate) fn analytic_branches(
     branches_with_wrist(robot, &robot.structure.wrist_zero, elbow, wrist, ow, near)
 }
 
-/// [`analytic_branches`] for a wrist centre that sits at `wrist_zero` when
-/// joints 1-4 are at zero (exact when joints 5-7 do not move W).
-fn branches_with_wrist(
+/// Every q4 that gives the triangle S-E-W the target's shape, with the
+/// rotation R1 R2 R3 that then places it on the target E and W.
+pub(crate) fn triangle_placements(
     robot: &Robot,
     wrist_zero: &Vector3,
     elbow: &Vector3,
     wrist: &Vector3,
-    ow: &Rotation3,
-    near: &JointVector,
-) -> Result<Vec<JointVector>, KinematicsError> {
+) -> Result<Vec<(Real, Matrix3)>, KinematicsError> {
     let s = &robot.structure;
     let (w, p) = (&s.axes_zero, &s.axis_points_zero);
     let d = wrist.norm();
@@ -235,21 +233,40 @@ fn branches_with_wrist(
         let (lu, lf) = (robot.upper_arm_length(), robot.forearm_length());
         return Err(KinematicsError::Unreachable { distance: d, min: (lu - lf).abs(), max: lu + lf });
     }
+    q4s.into_iter()
+        .map(|q4| {
+            let (s4, c4) = q4.sin_cos();
+            let wrist_moved = c0 + c4 * v_perp + s4 * w_perp;
+            align(&s.elbow_zero, &wrist_moved, elbow, wrist)
+                .map(|r123| (q4, r123))
+                .ok_or(KinematicsError::Singular(Singularity::StraightArm))
+        })
+        .collect()
+}
 
+/// [`analytic_branches`] for a wrist centre that sits at `wrist_zero` when
+/// joints 1-4 are at zero (exact when joints 5-7 do not move W).
+fn branches_with_wrist(
+    robot: &Robot,
+    wrist_zero: &Vector3,
+    elbow: &Vector3,
+    wrist: &Vector3,
+    ow: &Rotation3,
+    near: &JointVector,
+) -> Result<Vec<JointVector>, KinematicsError> {
+    let s = &robot.structure;
+    let w = &s.axes_zero;
     let mut out = Vec::with_capacity(8);
-    for q4 in q4s {
-        let (s4, c4) = q4.sin_cos();
-        let wrist_moved = c0 + c4 * v_perp + s4 * w_perp;
-        let r123 = align(&s.elbow_zero, &wrist_moved, elbow, wrist)
-            .ok_or(KinematicsError::Singular(Singularity::StraightArm))?;
+    for (q4, r123) in triangle_placements(robot, wrist_zero, elbow, wrist)? {
+        // Whatever the shoulder branch, R1 R2 R3 = r123: the wrist's share of
+        // Ow is the same for both, so it is split once per q4.
+        let r567 = (r123 * rotation_about(&w[3], q4)).transpose()
+            * ow.matrix()
+            * s.hand_zero.matrix().transpose();
+        let wrists = decompose(&r567, &w[4], &w[5], &w[6], near[4])?;
         for [q1, q2, q3] in decompose(&r123, &w[0], &w[1], &w[2], near[0])? {
-            let r1234 = rotation_about(&w[0], q1)
-                * rotation_about(&w[1], q2)
-                * rotation_about(&w[2], q3)
-                * rotation_about(&w[3], q4);
-            let r567 = r1234.transpose() * ow.matrix() * s.hand_zero.matrix().transpose();
-            for [q5, q6, q7] in decompose(&r567, &w[4], &w[5], &w[6], near[4])? {
-                let q = JointVector::from_column_slice(&[q1, q2, q3, q4, q5, q6, q7]);
+            for [q5, q6, q7] in &wrists {
+                let q = JointVector::from_column_slice(&[q1, q2, q3, q4, *q5, *q6, *q7]);
                 out.push(into_range(robot, q));
             }
         }

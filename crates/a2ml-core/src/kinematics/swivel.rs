@@ -12,7 +12,7 @@
 //! decides it, per group, since q4 does not depend on θ.
 
 use super::error::KinematicsError;
-use super::ik::{analytic_branches, decompose};
+use super::ik::{decompose, triangle_placements};
 use super::spaces::{CpsaState, cpsa_to_hat, hat_points};
 use crate::math::{Matrix3, PI, Real, Rotation3, Vector3, projector, rotation_about, skew, solve_trig};
 use crate::robot::Robot;
@@ -171,22 +171,16 @@ pub fn swivel_intervals(
     // does not depend on θ), so each q4 branch contributes the intersection
     // of the two groups' feasible sets.
     let mut feasible = Vec::new();
-    let mut seen_q4: Vec<Real> = Vec::new();
-    for q in analytic_branches(robot, &elbow0, &wrist, ow, &near)? {
-        if seen_q4.iter().any(|q4| (q4 - q[3]).abs() < 1e-12) {
+    for (q4, r0) in triangle_placements(robot, &s.wrist_zero, &elbow0, &wrist)? {
+        if !angle_within(limit(3), q4) {
             continue;
         }
-        seen_q4.push(q[3]);
-        if !angle_within(limit(3), q[3]) {
-            continue;
-        }
-        let r0 = rotation_about(&w[0], q[0]) * rotation_about(&w[1], q[1]) * rotation_about(&w[2], q[2]);
         let shoulder = Group {
             rotation: TrigMatrix { a: projector(&x) * r0, b: -skew(&x) * r0, c: xx * r0 },
             axes: [&w[0], &w[1], &w[2]],
             limits: [limit(0), limit(1), limit(2)],
         };
-        let r1234t = (r0 * rotation_about(&w[3], q[3])).transpose();
+        let r1234t = (r0 * rotation_about(&w[3], q4)).transpose();
         let wrist_group = Group {
             rotation: TrigMatrix {
                 a: r1234t * projector(&x) * hand,
