@@ -3,12 +3,12 @@
 
 use std::hint::black_box;
 
+use a2ml::Robot;
 use a2ml::kinematics::{
     arm_pose, cpsa_jacobian, cpsa_state, geometric_jacobian, hat_jacobian, hat_state, ik_cpsa,
     swivel_intervals,
 };
 use a2ml::math::JointVector;
-use a2ml::Robot;
 use criterion::{Criterion, criterion_group, criterion_main};
 
 fn robot(name: &str) -> Robot {

@@ -1,10 +1,11 @@
+use a2ml::Robot;
 use a2ml::kinematics::{ArmPose, arm_pose, cpsa_jacobian, hat_jacobian};
 use a2ml::math::{JointVector, Real, Vector3};
-use a2ml::Robot;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 
-pub const ROBOTS: [&str; 5] = ["coman_right_arm", "centauro_right_arm", "iiwa14", "panda", "human_arm"];
+pub const ROBOTS: [&str; 5] =
+    ["coman_right_arm", "centauro_right_arm", "iiwa14", "panda", "human_arm"];
 
 pub fn robot_path(name: &str) -> String {
     format!("{}/robots/{name}.urdf", env!("CARGO_MANIFEST_DIR"))

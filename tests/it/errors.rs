@@ -1,15 +1,16 @@
 //! Every typed error, provoked.
 
 use crate::common::{load, robot_path};
+use a2ml::Robot;
 use a2ml::kinematics::*;
 use a2ml::math::{Rotation3, Vector3};
 use a2ml::robot::{RobotError, RobotOptions};
-use a2ml::Robot;
 
 #[test]
 fn unreachable_wrist() {
     let robot = load("iiwa14");
-    let target = CpsaState { pw: Vector3::new(1.0, 0.2, 0.1), ow: Rotation3::identity(), swivel: 0.3 };
+    let target =
+        CpsaState { pw: Vector3::new(1.0, 0.2, 0.1), ow: Rotation3::identity(), swivel: 0.3 };
     match ik_cpsa(&robot, &target, None) {
         Err(KinematicsError::Unreachable { distance, max, .. }) => {
             assert!(distance > max && (max - 0.82).abs() < 1e-9);
@@ -29,21 +30,31 @@ fn straight_arm_is_singular() {
     q[1] = 0.7; // tilt the straight arm off the vertical
     let pose = arm_pose(&robot, &q);
     assert_eq!(cpsa_state(&robot, &pose), Err(KinematicsError::Singular(Singularity::StraightArm)));
-    assert_eq!(hat_jacobian(&pose).err(), Some(KinematicsError::Singular(Singularity::StraightArm)));
+    assert_eq!(
+        hat_jacobian(&pose).err(),
+        Some(KinematicsError::Singular(Singularity::StraightArm))
+    );
     // A HAT target with a straight elbow has no unique shoulder rotation.
     let target = HatState {
         shoulder_frame: Rotation3::identity(),
         elbow_angle: std::f64::consts::PI,
         ow: Rotation3::identity(),
     };
-    assert_eq!(ik_hat(&robot, &target, None), Err(KinematicsError::Singular(Singularity::StraightArm)));
+    assert_eq!(
+        ik_hat(&robot, &target, None),
+        Err(KinematicsError::Singular(Singularity::StraightArm))
+    );
 }
 
 #[test]
 fn wrist_above_shoulder_is_singular() {
     let robot = load("iiwa14");
-    let target = CpsaState { pw: Vector3::new(0.0, 0.0, 0.6), ow: Rotation3::identity(), swivel: 0.0 };
-    assert_eq!(ik_cpsa(&robot, &target, None), Err(KinematicsError::Singular(Singularity::WristAboveShoulder)));
+    let target =
+        CpsaState { pw: Vector3::new(0.0, 0.0, 0.6), ow: Rotation3::identity(), swivel: 0.0 };
+    assert_eq!(
+        ik_cpsa(&robot, &target, None),
+        Err(KinematicsError::Singular(Singularity::WristAboveShoulder))
+    );
     assert_eq!(
         swivel_intervals(&robot, &target.pw, &target.ow),
         Err(KinematicsError::Singular(Singularity::WristAboveShoulder))
@@ -73,7 +84,8 @@ fn targets_outside_the_limits_name_the_joint() {
 #[test]
 fn non_finite_targets_are_rejected() {
     let robot = load("iiwa14");
-    let target = CpsaState { pw: Vector3::new(f64::NAN, 0.0, 0.3), ow: Rotation3::identity(), swivel: 0.0 };
+    let target =
+        CpsaState { pw: Vector3::new(f64::NAN, 0.0, 0.3), ow: Rotation3::identity(), swivel: 0.0 };
     assert!(matches!(ik_cpsa(&robot, &target, None), Err(KinematicsError::NonFinite { .. })));
 }
 
@@ -82,7 +94,10 @@ fn newton_arms_have_no_closed_form_swivel() {
     let robot = load("human_arm");
     let pose = arm_pose(&robot, &robot.middle());
     let cpsa = cpsa_state(&robot, &pose).expect("regular");
-    assert!(matches!(swivel_intervals(&robot, &cpsa.pw, &cpsa.ow), Err(KinematicsError::NotAnalytic { .. })));
+    assert!(matches!(
+        swivel_intervals(&robot, &cpsa.pw, &cpsa.ow),
+        Err(KinematicsError::NotAnalytic { .. })
+    ));
 }
 
 #[test]
@@ -94,7 +109,9 @@ fn missing_file() {
 
 #[test]
 fn broken_urdf() {
-    let err = Robot::from_urdf_str("<robot name='x'><link name='a'></robot>", &RobotOptions::default()).unwrap_err();
+    let err =
+        Robot::from_urdf_str("<robot name='x'><link name='a'></robot>", &RobotOptions::default())
+            .unwrap_err();
     assert!(matches!(err, RobotError::Urdf { .. }), "{err:?}");
 }
 
@@ -130,7 +147,10 @@ fn ambiguous_chain() {
     }
     let err = Robot::from_urdf_str(&chain(7, &extra), &RobotOptions::default()).unwrap_err();
     assert!(matches!(err, RobotError::AmbiguousChain { .. }), "{err:?}");
-    let picked = Robot::from_urdf_str(&chain(7, &extra), &RobotOptions { tip: Some("l7".into()), ..Default::default() });
+    let picked = Robot::from_urdf_str(
+        &chain(7, &extra),
+        &RobotOptions { tip: Some("l7".into()), ..Default::default() },
+    );
     // The chosen chain has parallel axes 1 and 3 through one line: not an arm, but the chain itself was selected.
     assert!(!matches!(picked, Err(RobotError::AmbiguousChain { .. })));
 }
@@ -153,5 +173,8 @@ fn joint_without_limits() {
 fn unknown_link_suggests_a_name() {
     let options = RobotOptions { tip: Some("hnd".into()), ..Default::default() };
     let err = Robot::from_urdf_file_with(robot_path("iiwa14"), &options).unwrap_err();
-    assert_eq!(err, RobotError::UnknownLink { name: "hnd".into(), did_you_mean: Some("hand".into()) });
+    assert_eq!(
+        err,
+        RobotError::UnknownLink { name: "hnd".into(), did_you_mean: Some("hand".into()) }
+    );
 }

@@ -2,14 +2,17 @@
 //! mapping.
 
 use crate::common::{all_robots, regular_q, rng};
+use a2ml::Robot;
 use a2ml::kinematics::*;
 use a2ml::math::{JointVector, Real, rotation_distance, wrap_angle};
-use a2ml::Robot;
 
 const SAMPLES: usize = 10_000;
 
 fn cpsa_error(a: &CpsaState, b: &CpsaState) -> Real {
-    (a.pw - b.pw).norm().max(rotation_distance(&a.ow, &b.ow)).max(wrap_angle(a.swivel - b.swivel).abs())
+    (a.pw - b.pw)
+        .norm()
+        .max(rotation_distance(&a.ow, &b.ow))
+        .max(wrap_angle(a.swivel - b.swivel).abs())
 }
 
 fn hat_error(a: &HatState, b: &HatState) -> Real {
@@ -43,7 +46,10 @@ fn cpsa_ik_round_trip() {
                 assert!(err < tolerance(&robot), "{name}: CPSA round trip error {err:e}");
             }
             if robot.has_analytic_ik() {
-                assert!(contains(&solutions, &q), "{name}: the original branch is missing at {q:?}");
+                assert!(
+                    contains(&solutions, &q),
+                    "{name}: the original branch is missing at {q:?}"
+                );
             }
         }
     }
@@ -92,9 +98,17 @@ fn mapping_round_trips() {
             let cpsa = cpsa_state(&robot, &pose).expect("regular");
             let hat = cpsa_to_hat(&robot, &cpsa).expect("reachable");
             let back = hat_to_cpsa(&robot, &hat).expect("regular");
-            assert!(cpsa_error(&cpsa, &back) < 1e-12, "{name}: CPSA->HAT->CPSA {:e}", cpsa_error(&cpsa, &back));
+            assert!(
+                cpsa_error(&cpsa, &back) < 1e-12,
+                "{name}: CPSA->HAT->CPSA {:e}",
+                cpsa_error(&cpsa, &back)
+            );
             let again = cpsa_to_hat(&robot, &back).expect("reachable");
-            assert!(hat_error(&hat, &again) < 1e-12, "{name}: HAT->CPSA->HAT {:e}", hat_error(&hat, &again));
+            assert!(
+                hat_error(&hat, &again) < 1e-12,
+                "{name}: HAT->CPSA->HAT {:e}",
+                hat_error(&hat, &again)
+            );
         }
     }
 }
@@ -107,7 +121,8 @@ fn mapping_agrees_with_the_arm_on_analytic_arms() {
         let mut rng = rng(14);
         for _ in 0..1000 {
             let (_, pose) = regular_q(&robot, &mut rng, 0.1);
-            let mapped = cpsa_to_hat(&robot, &cpsa_state(&robot, &pose).expect("regular")).expect("reachable");
+            let mapped = cpsa_to_hat(&robot, &cpsa_state(&robot, &pose).expect("regular"))
+                .expect("reachable");
             let err = hat_error(&mapped, &hat_state(&pose).expect("regular"));
             assert!(err < 1e-9, "{name}: mapping differs from the arm by {err:e}");
         }

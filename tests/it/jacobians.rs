@@ -2,9 +2,9 @@
 //! and the SRS closed forms of paper eq. 8 and appendix B.
 
 use crate::common::{all_robots, load, regular_q, rng};
+use a2ml::Robot;
 use a2ml::kinematics::*;
 use a2ml::math::{JointVector, Matrix7, Real, Rotation3, Vector3, rotation_log, wrap_angle};
-use a2ml::Robot;
 
 const STEP: Real = 1e-6;
 const TOL: Real = 1e-6;
@@ -24,7 +24,10 @@ fn perturbed(q: &JointVector, i: usize) -> (JointVector, JointVector) {
 
 fn assert_close(name: &str, what: &str, analytic: &[Real], numeric: &[Real]) {
     for (k, (a, n)) in analytic.iter().zip(numeric).enumerate() {
-        assert!((a - n).abs() < TOL, "{name}: {what} entry {k}: analytic {a} vs finite difference {n}");
+        assert!(
+            (a - n).abs() < TOL,
+            "{name}: {what} entry {k}: analytic {a} vs finite difference {n}"
+        );
     }
 }
 
@@ -48,8 +51,18 @@ fn geometric_and_point_jacobians_match_finite_differences() {
                 let tp = pp.frames[7].transform_point(&tool_point.into()).coords;
                 let tm = pm.frames[7].transform_point(&tool_point.into()).coords;
                 let dt = (tp - tm) / (2.0 * STEP);
-                assert_close(name, "J_ge linear", jge.fixed_view::<3, 1>(0, i).as_slice(), dw.as_slice());
-                assert_close(name, "J_ge angular", jge.fixed_view::<3, 1>(3, i).as_slice(), dh.as_slice());
+                assert_close(
+                    name,
+                    "J_ge linear",
+                    jge.fixed_view::<3, 1>(0, i).as_slice(),
+                    dw.as_slice(),
+                );
+                assert_close(
+                    name,
+                    "J_ge angular",
+                    jge.fixed_view::<3, 1>(3, i).as_slice(),
+                    dh.as_slice(),
+                );
                 assert_close(name, "J_E", je.column(i).as_slice(), de.as_slice());
                 assert_close(name, "J_tool", jt.column(i).as_slice(), dt.as_slice());
             }
@@ -125,7 +138,8 @@ fn appendix_b(robot: &Robot, pose: &ArmPose) -> [Real; 7] {
     let scale = -1.0 / (1.0 - n.dot(&l).powi(2)).sqrt();
     std::array::from_fn(|i| {
         let jw: Vector3 = jge.fixed_view::<3, 1>(0, i).into();
-        let js: Vector3 = if i < 3 { jge.fixed_view::<3, 1>(3, i).into() } else { Vector3::zeros() };
+        let js: Vector3 =
+            if i < 3 { jge.fixed_view::<3, 1>(3, i).into() } else { Vector3::zeros() };
         scale * ((jw.dot(&n) / rho) * z.cross(&n).dot(&l) + n.dot(&js.cross(&l)))
     })
 }
@@ -147,7 +161,11 @@ fn srs_jacobians_equal_the_paper_closed_forms() {
         let b = appendix_b(&robot, &pose);
         for i in 0..7 {
             let ours = jcs[(6, i)];
-            assert!((ours - cpsa.swivel.signum() * b[i]).abs() < 1e-9, "J_sw col {i}: {ours} vs {}", b[i]);
+            assert!(
+                (ours - cpsa.swivel.signum() * b[i]).abs() < 1e-9,
+                "J_sw col {i}: {ours} vs {}",
+                b[i]
+            );
         }
         checked += 1;
     }

@@ -12,18 +12,42 @@ fn close(a: f64, b: f64, tol: f64) -> bool {
 fn structure_matches_reference_table() {
     // name, S in the base link, lu, lf, shoulder spherical, wrist spherical, srs
     let table = [
-        ("coman_right_arm", Vector3::new(-0.01498, -0.15580, 0.15771), 0.180624, 0.195257, true, true, false),
-        ("centauro_right_arm", Vector3::new(0.07628, -0.22201, 0.12739), 0.295595, 0.251448, true, true, false),
+        (
+            "coman_right_arm",
+            Vector3::new(-0.01498, -0.15580, 0.15771),
+            0.180624,
+            0.195257,
+            true,
+            true,
+            false,
+        ),
+        (
+            "centauro_right_arm",
+            Vector3::new(0.07628, -0.22201, 0.12739),
+            0.295595,
+            0.251448,
+            true,
+            true,
+            false,
+        ),
         ("iiwa14", Vector3::new(0.0, 0.0, 0.36), 0.42, 0.40, true, true, true),
         ("panda", Vector3::new(0.0, 0.0, 0.333), 0.326592, 0.392762, true, false, false),
     ];
     for (name, s, lu, lf, shoulder, wrist, srs) in table {
         let r = load(name);
         let st = &r.structure;
-        assert!((st.shoulder_in_base_link - s).norm() < 1e-5, "{name}: S {:?}", st.shoulder_in_base_link);
+        assert!(
+            (st.shoulder_in_base_link - s).norm() < 1e-5,
+            "{name}: S {:?}",
+            st.shoulder_in_base_link
+        );
         assert!(close(st.upper_arm_length, lu, 1e-6), "{name}: lu {}", st.upper_arm_length);
         assert!(close(st.forearm_length, lf, 1e-6), "{name}: lf {}", st.forearm_length);
-        assert_eq!((st.shoulder_spherical, st.wrist_spherical, st.is_srs), (shoulder, wrist, srs), "{name}");
+        assert_eq!(
+            (st.shoulder_spherical, st.wrist_spherical, st.is_srs),
+            (shoulder, wrist, srs),
+            "{name}"
+        );
     }
 }
 
@@ -54,7 +78,11 @@ fn every_robot_has_limits_and_arm_capsules() {
         assert_eq!(r.joint_names().len(), 7);
         assert!(r.lower().iter().zip(r.upper().iter()).all(|(l, u)| l < u), "{name}");
         assert!(r.velocity_limits().iter().all(|v| *v > 0.0), "{name}");
-        for role in [a2ml::robot::LinkRole::UpperArm, a2ml::robot::LinkRole::Forearm, a2ml::robot::LinkRole::Hand] {
+        for role in [
+            a2ml::robot::LinkRole::UpperArm,
+            a2ml::robot::LinkRole::Forearm,
+            a2ml::robot::LinkRole::Hand,
+        ] {
             assert!(r.capsules.iter().any(|c| c.role == role), "{name} lacks a {role:?} capsule");
         }
         assert_eq!(r.tip_link, "hand", "{name}");

@@ -16,7 +16,10 @@ fn swivel_intervals_agree_with_brute_force() {
             let cpsa = cpsa_state(&robot, &pose).expect("regular");
             let intervals = swivel_intervals(&robot, &cpsa.pw, &cpsa.ow).expect("reachable");
             // The configuration we came from is feasible.
-            assert!(intervals.iter().any(|i| i.contains(cpsa.swivel)), "{name}: own swivel excluded");
+            assert!(
+                intervals.iter().any(|i| i.contains(cpsa.swivel)),
+                "{name}: own swivel excluded"
+            );
             let near_boundary = |t: f64| {
                 intervals.iter().any(|i| (i.lower - t).abs() < 1e-6 || (i.upper - t).abs() < 1e-6)
             };
@@ -28,7 +31,10 @@ fn swivel_intervals_agree_with_brute_force() {
                 let target = CpsaState { swivel: theta, ..cpsa };
                 let brute = matches!(ik_cpsa(&robot, &target, None), Ok(ref s) if !s.is_empty());
                 let closed = intervals.iter().any(|i| i.contains(theta));
-                assert_eq!(closed, brute, "{name}: θsw {theta:.6} closed form {closed}, sweep {brute}, {intervals:?}");
+                assert_eq!(
+                    closed, brute,
+                    "{name}: θsw {theta:.6} closed form {closed}, sweep {brute}, {intervals:?}"
+                );
                 checked += 1;
             }
         }

@@ -1,2 +1,26 @@
-//! The `a2ml` command line.
-fn main() {}
+//! The `a2ml` command line: parses the arguments, runs the subcommand and
+//! turns the outcome into an exit code (0 success, 1 I/O error, 2 invalid
+//! input). Everything else lives in [`commands`] and the core library.
+
+mod args;
+mod commands;
+mod error;
+mod output;
+
+use std::io::Write;
+use std::process::ExitCode;
+
+use clap::Parser;
+
+fn main() -> ExitCode {
+    // clap prints its own usage errors and exits with code 2.
+    let cli = args::Cli::parse();
+    match commands::run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            // Nothing sensible is left to do if stderr itself is closed.
+            let _ = writeln!(std::io::stderr(), "error: {error}");
+            error.exit_code()
+        }
+    }
+}

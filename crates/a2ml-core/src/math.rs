@@ -156,8 +156,11 @@ mod tests {
         for angle in [0.0, 1e-12, 2e-6, 0.3, 2.5, PI - 1e-7, PI] {
             let r = Rotation3::from_matrix_unchecked(rotation_about(&axis, angle));
             let log = rotation_log(&r);
-            assert!((log - axis * angle).norm() < 1e-13 || (angle == PI && (log + axis * angle).norm() < 1e-13),
-                "angle {angle}: {log:?}");
+            assert!(
+                (log - axis * angle).norm() < 1e-13
+                    || (angle == PI && (log + axis * angle).norm() < 1e-13),
+                "angle {angle}: {log:?}"
+            );
             assert!((rotation_angle(&r) - angle).abs() < 1e-15 * angle.max(1.0) * 10.0);
         }
     }

@@ -28,7 +28,9 @@ impl std::fmt::Display for Singularity {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum KinematicsError {
     /// The wrist target is outside the reachable annulus.
-    #[error("wrist target at {distance:.6} m from the shoulder is unreachable (reach {min:.6}..{max:.6} m)")]
+    #[error(
+        "wrist target at {distance:.6} m from the shoulder is unreachable (reach {min:.6}..{max:.6} m)"
+    )]
     Unreachable {
         /// |Pw| asked for (m).
         distance: Real,
@@ -38,7 +40,9 @@ pub enum KinematicsError {
         max: Real,
     },
     /// Every solution leaves the joint limits; the least violating one is named.
-    #[error("joint `{joint}` would be at {value:.6} rad, outside [{lower:.6}, {upper:.6}] by {excess:.6} rad")]
+    #[error(
+        "joint `{joint}` would be at {value:.6} rad, outside [{lower:.6}, {upper:.6}] by {excess:.6} rad"
+    )]
     JointOutOfLimits {
         /// Joint name.
         joint: String,
@@ -68,8 +72,9 @@ pub enum KinematicsError {
         /// Which input.
         what: &'static str,
     },
-    /// The query needs a spherical shoulder and wrist.
-    #[error("{what} needs a spherical shoulder and wrist; this arm has neither or one")]
+    /// The query needs analytic IK: a spherical shoulder and a wrist centre
+    /// that joints 5-7 do not move.
+    #[error("{what} needs a spherical shoulder and a wrist centre that joints 5-7 do not move")]
     NotAnalytic {
         /// The query.
         what: &'static str,

@@ -1,7 +1,8 @@
 //! Forward kinematics and the geometric and point Jacobians.
 
 use crate::math::{
-    DOF, Isometry, Jacobian3x7, Jacobian6x7, JointVector, Rotation3, Vector3, rotation_about,
+    DOF, Isometry, Jacobian3x7, Jacobian6x7, JointVector, Matrix3, Real, Rotation3, Vector3,
+    rotation_about,
 };
 use crate::robot::Robot;
 
@@ -31,17 +32,39 @@ impl ArmPose {
     }
 }
 
+/// `r · Rot(axis, angle)`; URDF axes are mostly ±x, ±y or ±z, where the
+/// product only mixes two columns.
+#[inline]
+fn spin(r: &Matrix3, axis: &Vector3, angle: Real) -> Matrix3 {
+    let principal = (0..3).find(|&k| axis[(k + 1) % 3] == 0.0 && axis[(k + 2) % 3] == 0.0);
+    let Some(k) = principal else { return r * rotation_about(axis, angle) };
+    let (s, c) = (axis[k] * angle).sin_cos();
+    let (a, b) = ((k + 1) % 3, (k + 2) % 3);
+    let (ca, cb) = (r.column(a).into_owned(), r.column(b).into_owned());
+    let mut out = *r;
+    out.set_column(a, &(ca * c + cb * s));
+    out.set_column(b, &(cb * c - ca * s));
+    out
+}
+
 /// Forward kinematics of every moving frame, the axes and S, E, W.
 pub fn arm_pose(robot: &Robot, q: &JointVector) -> ArmPose {
     let mut frames = [Isometry::identity(); DOF + 1];
     let mut axes = [Vector3::zeros(); DOF];
     let mut axis_points = [Vector3::zeros(); DOF];
     for (k, joint) in robot.joints.iter().enumerate() {
-        let joint_frame = frames[k] * joint.parent_from_joint;
-        axes[k] = joint_frame.rotation * joint.axis;
-        axis_points[k] = joint_frame.translation.vector;
-        let spin = Rotation3::from_matrix_unchecked(rotation_about(&joint.axis, q[k]));
-        frames[k + 1] = Isometry::from_parts(joint_frame.translation, joint_frame.rotation * spin);
+        let parent = &frames[k];
+        let origin = &joint.parent_from_joint;
+        let translation = parent.translation.vector + parent.rotation * origin.translation.vector;
+        let rotation = if origin.rotation == Rotation3::identity() {
+            *parent.rotation.matrix()
+        } else {
+            parent.rotation.matrix() * origin.rotation.matrix()
+        };
+        axes[k] = rotation * joint.axis;
+        axis_points[k] = translation;
+        let spun = Rotation3::from_matrix_unchecked(spin(&rotation, &joint.axis, q[k]));
+        frames[k + 1] = Isometry::from_parts(translation.into(), spun);
     }
     let s = &robot.structure;
     ArmPose {

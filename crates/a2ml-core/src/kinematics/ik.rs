@@ -106,7 +106,9 @@ pub fn ik_hat_with(
     q_near: Option<&JointVector>,
     options: &IkOptions,
 ) -> Result<Vec<JointVector>, KinematicsError> {
-    if !(target.elbow_angle.is_finite() && target.shoulder_frame.matrix().iter().all(|v| v.is_finite())) {
+    if !(target.elbow_angle.is_finite()
+        && target.shoulder_frame.matrix().iter().all(|v| v.is_finite()))
+    {
         return Err(KinematicsError::NonFinite { what: "HAT state" });
     }
     let near = q_near.copied().unwrap_or_else(|| robot.middle());
@@ -231,7 +233,11 @@ pub(crate) fn triangle_placements(
     );
     if q4s.is_empty() {
         let (lu, lf) = (robot.upper_arm_length(), robot.forearm_length());
-        return Err(KinematicsError::Unreachable { distance: d, min: (lu - lf).abs(), max: lu + lf });
+        return Err(KinematicsError::Unreachable {
+            distance: d,
+            min: (lu - lf).abs(),
+            max: lu + lf,
+        });
     }
     q4s.into_iter()
         .map(|q4| {
@@ -280,10 +286,8 @@ fn into_range(robot: &Robot, mut q: JointVector) -> JointVector {
         let l = &joint.limits;
         let candidates = [q[i], q[i] - 2.0 * PI, q[i] + 2.0 * PI];
         let excess = |v: Real| (l.lower - v).max(v - l.upper).max(0.0);
-        q[i] = candidates
-            .into_iter()
-            .min_by(|a, b| excess(*a).total_cmp(&excess(*b)))
-            .unwrap_or(q[i]);
+        q[i] =
+            candidates.into_iter().min_by(|a, b| excess(*a).total_cmp(&excess(*b))).unwrap_or(q[i]);
     }
     q
 }
@@ -404,7 +408,8 @@ fn decoupled_guesses(
         return Vec::new();
     }
     let (w, p) = (&s.axes_zero, &s.axis_points_zero);
-    let about = |i: usize, angle: Real, x: &Vector3| p[i] + rotation_about(&w[i], angle) * (x - p[i]);
+    let about =
+        |i: usize, angle: Real, x: &Vector3| p[i] + rotation_about(&w[i], angle) * (x - p[i]);
     let wrist_zero = |q: &JointVector| about(4, q[4], &about(5, q[5], &s.wrist_zero));
     let solve = |q: &JointVector| branches_with_wrist(robot, &wrist_zero(q), elbow, wrist, ow, q);
     let Ok(branches) = solve(near) else { return Vec::new() };
@@ -451,7 +456,8 @@ where
     let mut best = Real::INFINITY;
     // A caller's q_near is usually close: try it before paying for guesses.
     let near_start = std::iter::once(*near);
-    let (before, after) = if near_first { (Some(near_start), None) } else { (None, Some(near_start)) };
+    let (before, after) =
+        if near_first { (Some(near_start), None) } else { (None, Some(near_start)) };
     let starts = before
         .into_iter()
         .flatten()

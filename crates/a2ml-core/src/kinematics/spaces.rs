@@ -36,7 +36,10 @@ pub struct HatState {
 }
 
 /// n: unit normal of the vertical plane through S and W, and |Pw × (-z_b)|.
-fn vertical_plane_normal(pw: &Vector3, vertical: &Vector3) -> Result<(Vector3, Real), KinematicsError> {
+fn vertical_plane_normal(
+    pw: &Vector3,
+    vertical: &Vector3,
+) -> Result<(Vector3, Real), KinematicsError> {
     let m = vertical.cross(pw);
     let norm = m.norm();
     if norm < VERTICAL_TOL {
@@ -46,7 +49,11 @@ fn vertical_plane_normal(pw: &Vector3, vertical: &Vector3) -> Result<(Vector3, R
 }
 
 /// θsw from Pw and the arm-plane normal l: `l = Rot(x, -θsw) n`.
-pub fn swivel_angle(pw: &Vector3, l: &Vector3, vertical: &Vector3) -> Result<Real, KinematicsError> {
+pub fn swivel_angle(
+    pw: &Vector3,
+    l: &Vector3,
+    vertical: &Vector3,
+) -> Result<Real, KinematicsError> {
     let (n, _) = vertical_plane_normal(pw, vertical)?;
     let x = pw.normalize();
     Ok((-n.cross(l).dot(&x)).atan2(n.dot(l)))

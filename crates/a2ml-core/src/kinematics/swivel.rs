@@ -14,7 +14,9 @@
 use super::error::KinematicsError;
 use super::ik::{decompose, triangle_placements};
 use super::spaces::{CpsaState, cpsa_to_hat, hat_points};
-use crate::math::{Matrix3, PI, Real, Rotation3, Vector3, projector, rotation_about, skew, solve_trig};
+use crate::math::{
+    Matrix3, PI, Real, Rotation3, Vector3, projector, rotation_about, skew, solve_trig,
+};
 use crate::robot::Robot;
 
 /// A closed interval of swivel angles [lower, upper] within [-π, π] (rad).

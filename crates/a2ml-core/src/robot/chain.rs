@@ -11,10 +11,7 @@ use crate::math::{DOF, Isometry, Real, Rotation3, Translation3, Vector3};
 fn pose(p: &urdf_rs::Pose) -> Isometry {
     let [x, y, z] = p.xyz.0;
     let [roll, pitch, yaw] = p.rpy.0;
-    Isometry::from_parts(
-        Translation3::new(x, y, z),
-        Rotation3::from_euler_angles(roll, pitch, yaw),
-    )
+    Isometry::from_parts(Translation3::new(x, y, z), Rotation3::from_euler_angles(roll, pitch, yaw))
 }
 
 fn is_movable(kind: &urdf_rs::JointType) -> bool {
@@ -135,9 +132,9 @@ impl<'a> Tree<'a> {
         };
         if let Some(tip) = &options.tip {
             self.check_link(tip)?;
-            let path = self.path(&base, tip).ok_or_else(|| RobotError::NotAnthropomorphic {
-                reason: format!("link `{base}` is not an ancestor of `{tip}`"),
-            })?;
+            let path = self
+                .path(&base, tip)
+                .ok_or_else(|| RobotError::NotAncestor { base: base.clone(), tip: tip.clone() })?;
             return Ok((base, path));
         }
         let leaves = self.leaves_below(&base);
@@ -149,7 +146,8 @@ impl<'a> Tree<'a> {
             return Err(if longest > DOF || longest == 0 {
                 RobotError::NoSevenDofChain { longest }
             } else {
-                let p = paths.iter().max_by_key(|p| self.movable(p).len()).cloned().unwrap_or_default();
+                let p =
+                    paths.iter().max_by_key(|p| self.movable(p).len()).cloned().unwrap_or_default();
                 self.not_seven(&base, &p)
             });
         };
@@ -268,7 +266,8 @@ pub(super) fn build(urdf: &urdf_rs::Robot, options: &RobotOptions) -> Result<Rob
 
     // Walk the chain in base-link coordinates; shift to {b} once S is known.
     let mut joints: Vec<Joint> = Vec::with_capacity(DOF);
-    let mut links = vec![ChainLink { name: base.clone(), frame: 0, frame_from_link: Isometry::identity() }];
+    let mut links =
+        vec![ChainLink { name: base.clone(), frame: 0, frame_from_link: Isometry::identity() }];
     let mut acc = Isometry::identity();
     for &j in &path {
         let joint = &urdf.joints[j];
@@ -298,7 +297,11 @@ pub(super) fn build(urdf: &urdf_rs::Robot, options: &RobotOptions) -> Result<Rob
                 });
             }
         }
-        links.push(ChainLink { name: joint.child.link.clone(), frame: joints.len(), frame_from_link: acc });
+        links.push(ChainLink {
+            name: joint.child.link.clone(),
+            frame: joints.len(),
+            frame_from_link: acc,
+        });
     }
     let tip = links.last().map(|l| l.name.clone()).unwrap_or_else(|| base.clone());
     let frame7_from_hand = acc.rotation * tool;

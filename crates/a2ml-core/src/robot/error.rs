@@ -33,8 +33,18 @@ pub enum RobotError {
         /// The closest existing link name.
         did_you_mean: Option<String>,
     },
+    /// The base link is not an ancestor of the tip link.
+    #[error("link `{base}` is not an ancestor of `{tip}`, so there is no chain between them")]
+    NotAncestor {
+        /// Base link asked for.
+        base: String,
+        /// Tip link asked for.
+        tip: String,
+    },
     /// The chain between base and tip does not have 7 revolute joints.
-    #[error("the chain {base} -> {tip} has {found} revolute joints ({joints}); an anthropomorphic arm needs 7")]
+    #[error(
+        "the chain {base} -> {tip} has {found} revolute joints ({joints}); an anthropomorphic arm needs 7"
+    )]
     NotSevenDof {
         /// Base link.
         base: String,
@@ -66,7 +76,9 @@ pub enum RobotError {
         kind: String,
     },
     /// A revolute joint without usable limits.
-    #[error("joint `{joint}` has no usable limits (lower {lower}, upper {upper}, velocity {velocity})")]
+    #[error(
+        "joint `{joint}` has no usable limits (lower {lower}, upper {upper}, velocity {velocity})"
+    )]
     JointWithoutLimits {
         /// Joint name.
         joint: String,

@@ -11,7 +11,7 @@ mod error;
 mod structure;
 
 pub use error::RobotError;
-pub use structure::{ArmStructure, line_distance, least_squares_point};
+pub use structure::{ArmStructure, least_squares_point, line_distance};
 
 use crate::math::{DOF, Isometry, JointVector, Real, Rotation3, Vector3};
 
@@ -78,6 +78,16 @@ pub enum LinkRole {
 }
 
 impl LinkRole {
+    /// The snake_case name used in outputs.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Base => "base",
+            Self::UpperArm => "upper_arm",
+            Self::Forearm => "forearm",
+            Self::Hand => "hand",
+        }
+    }
+
     /// The role of a link attached to moving frame `frame`.
     pub fn of_frame(frame: usize) -> Self {
         match frame {
@@ -106,6 +116,13 @@ pub struct Capsule {
     pub b: Vector3,
     /// Radius (m).
     pub radius: Real,
+}
+
+impl Capsule {
+    /// Length of the segment, caps excluded (m).
+    pub fn length(&self) -> Real {
+        (self.b - self.a).norm()
+    }
 }
 
 /// How to read a URDF into a [`Robot`].

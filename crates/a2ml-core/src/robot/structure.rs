@@ -68,11 +68,7 @@ pub fn least_squares_point(lines: &[(Vector3, Vector3)]) -> Option<(Vector3, Rea
 pub fn line_distance(p1: &Vector3, d1: &Vector3, p2: &Vector3, d2: &Vector3) -> Real {
     let n = d1.cross(d2);
     let w = p2 - p1;
-    if n.norm() < 1e-12 {
-        (w - d1 * d1.dot(&w)).norm()
-    } else {
-        w.dot(&n).abs() / n.norm()
-    }
+    if n.norm() < 1e-12 { (w - d1 * d1.dot(&w)).norm() } else { w.dot(&n).abs() / n.norm() }
 }
 
 /// The point of line (p, d) nearest to `x`.
@@ -129,10 +125,10 @@ pub(crate) fn analyse(
         line_distance(&points[2], &axes[2], &points[3], &axes[3]),
         line_distance(&points[3], &axes[3], &points[4], &axes[4]),
     ];
-    let wrist_decoupled = [4, 5].iter().all(|&i| projector(&axes[i]).mul(&(wrist - points[i])).norm() < MEET_TOL);
-    let is_srs = shoulder_spherical
-        && wrist_spherical
-        && elbow_offsets.iter().all(|o| *o < MEET_TOL);
+    let wrist_decoupled =
+        [4, 5].iter().all(|&i| projector(&axes[i]).mul(&(wrist - points[i])).norm() < MEET_TOL);
+    let is_srs =
+        shoulder_spherical && wrist_spherical && elbow_offsets.iter().all(|o| *o < MEET_TOL);
 
     // Everything below is in {b}: the base link shifted so that S is the origin.
     let axes_zero = *axes;

@@ -1,0 +1,29 @@
+//! The command-line grammar: the top-level [`Cli`] and one [`Commands`]
+//! variant per subcommand, each with its arguments in its own module.
+
+use clap::{Parser, Subcommand};
+
+use crate::commands::robot::RobotArgs;
+
+/// Plans human-like motions for 7-DoF anthropomorphic arms from A2ML tasks.
+#[derive(Debug, Parser)]
+#[command(name = "a2ml", version, arg_required_else_help = true)]
+#[command(after_help = "\
+Examples:
+  a2ml robot robots/iiwa14.urdf
+  a2ml robot robots/iiwa14.urdf --at 0.3,0.5,-0.2,1.2,0.4,-0.6,0.1
+  a2ml robot robots/panda.urdf --at 0,-45,0,-135,0,90,45 --deg --json
+
+Exit codes: 0 success, 1 I/O error, 2 invalid input.")]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Commands,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Commands {
+    /// Show what a2ml reads from a URDF, and the arm's state at a configuration.
+    Robot(RobotArgs),
+}

@@ -1,0 +1,17 @@
+//! One module per subcommand, each with its clap arguments and a `run`
+//! that calls the core and prints the result. [`run`] dispatches.
+
+pub mod robot;
+
+use crate::args::{Cli, Commands};
+use crate::error::CliError;
+
+/// Runs the subcommand the command line names.
+///
+/// # Errors
+/// The subcommand's [`CliError`].
+pub fn run(cli: Cli) -> Result<(), CliError> {
+    match cli.command {
+        Commands::Robot(args) => robot::run(&args),
+    }
+}
