@@ -6,12 +6,45 @@ VENV   := .venv
 VPY    := $(VENV)/bin/python
 CARGO  ?= cargo
 
-.PHONY: test rust-test build clean
+# One target directory for cargo and maturin, so the core is built once.
+export CARGO_TARGET_DIR ?= $(CURDIR)/target
 
-test: rust-test
+PY_CRATE  := crates/a2ml-py
+PY_REQS   := tests/python/requirements.txt
+WHEEL_DIR := $(CARGO_TARGET_DIR)/wheels
+# The wheel is rebuilt when anything it is built from changes.
+PY_INPUTS := $(shell find crates/a2ml-core crates/a2ml-py -type f -not -name '*.pyc') Cargo.toml Cargo.lock
+
+.PHONY: test rust-test py-test python build clean
+
+test: rust-test py-test
 
 rust-test:
 	$(CARGO) test --workspace --exclude a2ml-py
+
+# The venv with the build and test tools; remade only when the pins change.
+$(VENV)/.tools-installed: $(PY_REQS)
+	$(PYTHON) -m venv $(VENV)
+	$(VPY) -m pip install --quiet --disable-pip-version-check -r $(PY_REQS)
+	touch $@
+
+# Build the abi3 wheel (cp39-abi3) and install it into the venv, as a user's
+# `pip install` would.
+$(VENV)/.wheel-installed: $(VENV)/.tools-installed $(PY_INPUTS)
+	rm -f $(WHEEL_DIR)/a2ml-*.whl
+	$(VENV)/bin/maturin build --release --manifest-path $(PY_CRATE)/Cargo.toml --interpreter $(VPY) --out $(WHEEL_DIR)
+	$(VPY) -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps $(WHEEL_DIR)/a2ml-*.whl
+	touch $@
+
+python: $(VENV)/.wheel-installed
+
+# pytest, then the hand-written stubs: stubtest checks them against the
+# installed module, and mypy (strict) checks that the tests type-check
+# against them as a user's code would.
+py-test: python
+	$(VPY) -m pytest tests/python
+	$(VPY) -m mypy.stubtest a2ml --mypy-config-file tests/python/mypy.ini
+	$(VPY) -m mypy --config-file tests/python/mypy.ini tests/python
 
 build:
 	$(CARGO) build --release -p a2ml-cli

@@ -252,7 +252,11 @@ fn hand_rotation(options: &RobotOptions) -> Result<Rotation3, RobotError> {
     }
 }
 
-pub(super) fn build(urdf: &urdf_rs::Robot, options: &RobotOptions) -> Result<Robot, RobotError> {
+pub(super) fn build(
+    urdf: &urdf_rs::Robot,
+    text: &str,
+    options: &RobotOptions,
+) -> Result<Robot, RobotError> {
     let tree = Tree::new(urdf);
     let (base, path) = tree.select(options)?;
     let movable = tree.movable(&path);
@@ -346,5 +350,6 @@ pub(super) fn build(urdf: &urdf_rs::Robot, options: &RobotOptions) -> Result<Rob
         frame7_from_hand,
         vertical,
         structure,
+        urdf: text.to_owned(),
     })
 }

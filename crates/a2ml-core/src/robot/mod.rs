@@ -175,6 +175,9 @@ pub struct Robot {
     pub vertical: Vector3,
     /// Shoulder, elbow and wrist structure.
     pub structure: ArmStructure,
+    /// The URDF document the model was read from (to attach to outputs and
+    /// to rebuild the model elsewhere).
+    pub urdf: String,
 }
 
 impl Robot {
@@ -213,7 +216,7 @@ impl Robot {
     pub fn from_urdf_str(text: &str, options: &RobotOptions) -> Result<Self, RobotError> {
         let urdf = urdf_rs::read_from_string(text)
             .map_err(|e| RobotError::Urdf { path: None, message: e.to_string() })?;
-        chain::build(&urdf, options)
+        chain::build(&urdf, text, options)
     }
 
     /// Joint names, base to tip.
