@@ -1,12 +1,15 @@
 //! a2ml: plans human-like motions for 7-DoF anthropomorphic arms from tasks
 //! written in A2ML (Fang & Ding 2019).
 //!
-//! The modules follow the pipeline: [`robot`] (URDF to an arm model) then
-//! [`kinematics`] (FK, CPSA and HAT states, Jacobians, IK).
+//! The modules follow the pipeline: [`robot`] (URDF to an arm model),
+//! [`kinematics`] (FK, CPSA and HAT states, Jacobians, IK), [`language`]
+//! (task files to a validated [`language::Task`]).
 
 pub mod error;
 pub mod kinematics;
+pub mod language;
 pub mod math;
+pub mod names;
 pub mod robot;
 
 pub use error::Error;

@@ -31,22 +31,6 @@ fn kind_name(kind: &urdf_rs::JointType) -> &'static str {
     }
 }
 
-/// Levenshtein distance, for did-you-mean suggestions.
-pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut prev = row[0];
-        row[0] = i + 1;
-        for (j, cb) in b.iter().enumerate() {
-            let cur = row[j + 1];
-            row[j + 1] = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(cur + 1);
-            prev = cur;
-        }
-    }
-    row[b.len()]
-}
-
 struct Tree<'a> {
     urdf: &'a urdf_rs::Robot,
     /// child link -> index of the joint whose child it is
@@ -68,7 +52,7 @@ impl<'a> Tree<'a> {
             .urdf
             .links
             .iter()
-            .map(|l| (edit_distance(name, &l.name), &l.name))
+            .map(|l| (crate::names::edit_distance(name, &l.name), &l.name))
             .filter(|(d, _)| *d <= name.len().max(3) / 2)
             .min()
             .map(|(_, n)| n.clone());

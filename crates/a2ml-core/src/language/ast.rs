@@ -1,0 +1,395 @@
+//! The typed syntax tree of an A2ML file, as written: names are strings,
+//! numbers carry the unit they were written with, and every node has the
+//! byte span of its text. [`super::validate`] turns it into a [`super::Task`].
+
+use crate::math::Real;
+
+/// A byte range of the source text.
+///
+/// Spans take no part in equality, so that two parses of differently
+/// formatted text compare equal when they say the same thing.
+#[derive(Debug, Clone, Copy, Default, Eq, serde::Serialize)]
+pub struct Span {
+    /// First byte.
+    pub start: usize,
+    /// One past the last byte.
+    pub end: usize,
+}
+
+impl PartialEq for Span {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+/// A name, keyword argument or string with its span.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Name {
+    /// The text (strings without their quotes).
+    pub text: String,
+    /// Where it was written.
+    pub span: Span,
+}
+
+/// A number with an optional unit: `0.3 m`, `45 deg`, `2`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Quantity {
+    /// The number as written.
+    pub value: Real,
+    /// The unit as written.
+    pub unit: Option<Name>,
+    /// The whole quantity.
+    pub span: Span,
+}
+
+/// A bracketed list of numbers with one optional unit: `[0, 30, 0] deg`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Vector {
+    /// The numbers as written.
+    pub values: Vec<Real>,
+    /// The unit as written.
+    pub unit: Option<Name>,
+    /// The whole vector.
+    pub span: Span,
+}
+
+/// A value as written.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub enum Value {
+    /// A scalar.
+    Quantity(Quantity),
+    /// A vector.
+    Vector(Vector),
+    /// `rpy(roll, pitch, yaw) unit`: about fixed x, y, z.
+    Rpy {
+        /// Roll, pitch, yaw as written.
+        angles: [Real; 3],
+        /// The unit as written.
+        unit: Option<Name>,
+        /// The whole value.
+        span: Span,
+    },
+    /// `quat(w, x, y, z)`.
+    Quat {
+        /// w, x, y, z as written.
+        wxyz: [Real; 4],
+        /// The whole value.
+        span: Span,
+    },
+    /// `axes(f: [..], p: [..])` or `axes(r: [..], l: [..])`.
+    Axes {
+        /// The two named directions.
+        pairs: [(Name, Vector); 2],
+        /// The whole value.
+        span: Span,
+    },
+}
+
+impl Value {
+    /// The span of the value.
+    pub fn span(&self) -> Span {
+        match self {
+            Value::Quantity(q) => q.span,
+            Value::Vector(v) => v.span,
+            Value::Rpy { span, .. } | Value::Quat { span, .. } | Value::Axes { span, .. } => *span,
+        }
+    }
+}
+
+/// A whole A2ML file.
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
+pub struct File {
+    /// Top-level items in source order.
+    pub items: Vec<Item>,
+}
+
+/// A top-level item.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub enum Item {
+    /// `robot "path.urdf"`.
+    Robot(Name),
+    /// `start ...`.
+    Start(Start),
+    /// `scene { ... }`.
+    Scene(Scene),
+    /// `settings { ... }`.
+    Settings(Settings),
+    /// `task name { ... }`.
+    Task(Task),
+}
+
+/// The start configuration.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub enum Start {
+    /// Joint angles.
+    Joints(Vector),
+    /// A state in CPSA or HAT space: `Pw [..] Ow rpy(..) θsw 30 deg`.
+    State {
+        /// Variable-value pairs.
+        entries: Vec<(Name, Value)>,
+        /// The whole list.
+        span: Span,
+    },
+}
+
+/// The obstacles.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Scene {
+    /// Obstacles in source order.
+    pub obstacles: Vec<Obstacle>,
+    /// The `scene` keyword.
+    pub span: Span,
+}
+
+/// `name = shape`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Obstacle {
+    /// Obstacle name.
+    pub name: Name,
+    /// Its shape.
+    pub shape: Shape,
+    /// The whole declaration.
+    pub span: Span,
+}
+
+/// An obstacle's shape as written.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub enum Shape {
+    /// `box at [..] size [..]`: centre and full edge lengths.
+    Box {
+        /// Centre.
+        at: Vector,
+        /// Edge lengths.
+        size: Vector,
+    },
+    /// `sphere at [..] radius r`.
+    Sphere {
+        /// Centre.
+        at: Vector,
+        /// Radius.
+        radius: Quantity,
+    },
+    /// `capsule from [..] to [..] radius r`.
+    Capsule {
+        /// Segment start.
+        from: Vector,
+        /// Segment end.
+        to: Vector,
+        /// Radius.
+        radius: Quantity,
+    },
+    /// `cylinder at [..] radius r height h`: vertical, centred at `at`.
+    Cylinder {
+        /// Centre.
+        at: Vector,
+        /// Radius.
+        radius: Quantity,
+        /// Height.
+        height: Quantity,
+    },
+    /// A shape keyword the grammar does not know.
+    Unknown(Name),
+}
+
+/// `settings { name value ... }`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Settings {
+    /// Entries in source order.
+    pub entries: Vec<Setting>,
+    /// The `settings` keyword.
+    pub span: Span,
+}
+
+/// One setting.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Setting {
+    /// Setting name.
+    pub name: Name,
+    /// Its value.
+    pub value: SettingValue,
+    /// The whole entry.
+    pub span: Span,
+}
+
+/// A setting's value.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub enum SettingValue {
+    /// A number with a unit.
+    Quantity(Quantity),
+    /// A word.
+    Word(Name),
+}
+
+/// A set of STRIPS facts: `{ a, b }`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Facts {
+    /// Fact names.
+    pub names: Vec<Name>,
+    /// The braces.
+    pub span: Span,
+}
+
+/// `task name { init goal actions }`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Task {
+    /// Task name.
+    pub name: Name,
+    /// `init { .. }` statements.
+    pub init: Vec<Facts>,
+    /// `goal { .. }` statements.
+    pub goal: Vec<Facts>,
+    /// Actions in source order.
+    pub actions: Vec<Action>,
+    /// The header.
+    pub span: Span,
+}
+
+/// One action.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Action {
+    /// Action name.
+    pub name: Name,
+    /// Optional description string.
+    pub description: Option<Name>,
+    /// `pre`, `add`, `del` statements.
+    pub pre: Vec<Facts>,
+    /// Facts the action makes true.
+    pub add: Vec<Facts>,
+    /// Facts the action makes false.
+    pub del: Vec<Facts>,
+    /// `solver` statements.
+    pub solver: Vec<Name>,
+    /// Constraints or explicit segments.
+    pub body: ActionBody,
+    /// The action's name.
+    pub span: Span,
+}
+
+/// The two forms of an action.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub enum ActionBody {
+    /// Goal and path constraints, decomposed automatically.
+    Constraints {
+        /// `goal` statements.
+        goals: Vec<Goal>,
+        /// `path` statements.
+        paths: Vec<Path>,
+        /// `duration` statements.
+        durations: Vec<Quantity>,
+    },
+    /// Segments of primitives, as in paper eq. 4.
+    Explicit {
+        /// Segments joined with `+Tr`.
+        segments: Vec<Segment>,
+    },
+}
+
+/// `goal A = a > B = b`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Goal {
+    /// One term, or two in priority order (higher first).
+    pub terms: Vec<GoalTerm>,
+    /// The `goal` keyword.
+    pub span: Span,
+}
+
+/// `V1 V2 = (v1, v2)`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct GoalTerm {
+    /// Variables.
+    pub variables: Vec<Name>,
+    /// One value per variable.
+    pub values: Vec<Value>,
+    /// The whole term.
+    pub span: Span,
+}
+
+/// `path item, item : hard`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Path {
+    /// The constrained variables and their features.
+    pub items: Vec<PathItem>,
+    /// `hard` (default) or `soft`.
+    pub hardness: Option<Name>,
+    /// The `path` keyword.
+    pub span: Span,
+}
+
+/// `V feature`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PathItem {
+    /// Variables.
+    pub variables: Vec<Name>,
+    /// What they keep.
+    pub feature: Feature,
+    /// The whole item.
+    pub span: Span,
+}
+
+/// A path feature P with its size S.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub enum Feature {
+    /// `line [dir] length`.
+    Line {
+        /// Direction in {b}.
+        direction: Vector,
+        /// Distance along it, if given.
+        size: Option<Quantity>,
+    },
+    /// `about axis angle`.
+    About {
+        /// Axis name: x y z -x -y -z r l f p (and negations).
+        axis: Name,
+        /// Angle about it, if given.
+        size: Option<Quantity>,
+    },
+    /// `by angle`.
+    By {
+        /// Signed angle.
+        size: Quantity,
+    },
+    /// `hold`.
+    Hold,
+}
+
+/// `segment T { P +Pa P -Pa P }`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Segment {
+    /// Duration, if given.
+    pub duration: Option<Quantity>,
+    /// Primitives, each with the operator before it (`+Pa` for the first).
+    pub primitives: Vec<(Combine, Primitive)>,
+    /// The `segment` keyword.
+    pub span: Span,
+}
+
+/// How a primitive joins the ones before it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Combine {
+    /// `+Pa`: in parallel.
+    Add,
+    /// `-Pa`: removed (paper's MP−).
+    Remove,
+}
+
+/// `V.goal(..)`, `(V W).path(..)`, `V.hold`, or bare `V` after `-Pa`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Primitive {
+    /// Variables.
+    pub variables: Vec<Name>,
+    /// The constraint, if written.
+    pub constraint: Option<PrimitiveConstraint>,
+    /// The whole primitive.
+    pub span: Span,
+}
+
+/// A primitive's constraint.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub enum PrimitiveConstraint {
+    /// `.goal(values)`.
+    Goal(Vec<Value>),
+    /// `.path(feature)`.
+    Path(Feature),
+    /// `.hold`.
+    Hold,
+}

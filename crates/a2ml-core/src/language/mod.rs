@@ -1,0 +1,69 @@
+//! The A2ML task language: text -> syntax tree ([`ast`]) -> validated
+//! [`Task`], with located diagnostics.
+//!
+//! Entry points: [`parse`] (text), [`load`] (a file), [`parse_ast`] (the
+//! syntax tree alone). Units become SI at
+//! validation; every syntax node keeps the byte span of its text.
+
+pub mod ast;
+mod diagnostic;
+mod syntax;
+mod task;
+mod validate;
+
+use std::path::Path;
+
+pub use diagnostic::{Diagnostic, Diagnostics};
+pub use task::*;
+
+/// Why a task file could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum LanguageError {
+    /// The file cannot be read.
+    #[error("cannot read {path}: {message}")]
+    Io {
+        /// The path as given.
+        path: String,
+        /// The OS message.
+        message: String,
+    },
+    /// The text is not a valid task.
+    #[error("{0}")]
+    Invalid(Diagnostics),
+}
+
+fn diagnostics(text: &str, path: Option<&Path>, items: Vec<Diagnostic>) -> Diagnostics {
+    Diagnostics { path: path.map(|p| p.display().to_string()), source: text.to_owned(), items }
+}
+
+/// Parses text into its syntax tree (no validation).
+///
+/// # Errors
+/// The syntax error, located.
+pub fn parse_ast(text: &str, path: Option<&Path>) -> Result<ast::File, Diagnostics> {
+    syntax::parse_file(text).map_err(|d| diagnostics(text, path, vec![d]))
+}
+
+/// Parses and validates a task; `path` names the file in messages and
+/// anchors the robot path.
+///
+/// # Errors
+/// Every problem found, located.
+pub fn parse(text: &str, path: Option<&Path>) -> Result<Task, Diagnostics> {
+    let file = parse_ast(text, path)?;
+    let base_dir = path.map(|p| p.parent().unwrap_or(Path::new("")));
+    validate::validate(&file, base_dir).map_err(|items| diagnostics(text, path, items))
+}
+
+/// Reads, parses and validates a task file.
+///
+/// # Errors
+/// [`LanguageError::Io`] or every problem found.
+pub fn load(path: impl AsRef<Path>) -> Result<Task, LanguageError> {
+    let path = path.as_ref();
+    let text = std::fs::read_to_string(path).map_err(|e| LanguageError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    parse(&text, Some(path)).map_err(LanguageError::Invalid)
+}

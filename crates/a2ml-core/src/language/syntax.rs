@@ -1,0 +1,455 @@
+//! Text to [`ast::File`] with pest; pest enters the library here and
+//! nowhere else.
+
+use pest::Parser as _;
+use pest::iterators::Pair;
+
+use super::ast::{self, Name, Span};
+use super::diagnostic::Diagnostic;
+use crate::math::Real;
+
+#[derive(pest_derive::Parser)]
+#[grammar = "../../../grammar/a2ml.pest"]
+struct A2mlParser;
+
+type Node<'a> = Pair<'a, Rule>;
+
+/// Parses A2ML text into its syntax tree.
+///
+/// # Errors
+/// The syntax error, located.
+pub fn parse_file(text: &str) -> Result<ast::File, Diagnostic> {
+    let mut pairs = A2mlParser::parse(Rule::file, text).map_err(syntax_error)?;
+    let file = pairs.next().ok_or_else(|| Diagnostic::new(Span::default(), "empty input"))?;
+    Ok(ast::File {
+        items: file.into_inner().filter(|p| p.as_rule() != Rule::EOI).map(item).collect(),
+    })
+}
+
+/// What a rule is called in messages.
+fn describe(rule: &Rule) -> String {
+    use Rule::*;
+    match rule {
+        EOI => "end of file",
+        robot => "`robot`",
+        start => "`start`",
+        scene => "`scene`",
+        settings => "`settings`",
+        task => "`task`",
+        action => "`action`",
+        name | ident => "a name",
+        string | string_body => "a string in double quotes",
+        number => "a number",
+        quantity => "a number",
+        unit => "a unit",
+        vector => "a vector like [0.1, 0.2, 0.3]",
+        value | values => "a value (number, vector or rotation)",
+        rpy => "rpy(roll, pitch, yaw)",
+        quat => "quat(w, x, y, z)",
+        axes => "axes(f: [..], p: [..])",
+        variable | variables | primitive_vars => "a state variable (Pw, Ow, θsw, Os, θe)",
+        axis => "an axis (x, y, z, -x, -y, -z, r, l, f, p)",
+        obstacle => "an obstacle `name = shape ...`",
+        shape => "a shape (box, sphere, capsule, cylinder)",
+        setting => "a setting `name value`",
+        facts => "a fact list `{ a, b }`",
+        init => "`init`",
+        task_goal => "`goal { facts }`",
+        se => "`+Se`",
+        tr => "`+Tr`",
+        pa => "`+Pa` or `-Pa`",
+        constraint_body => "an action body `{ ... }`",
+        explicit_body => "`explicit { segment ... }`",
+        goal => "`goal`",
+        goal_term => "`variables = values`",
+        priority => "`>`",
+        path => "`path`",
+        path_item => "`variables feature`",
+        hardness => "`hard` or `soft`",
+        feature => "a path feature (line, about, by, hold)",
+        line => "`line [direction] length`",
+        about => "`about axis angle`",
+        by => "`by angle`",
+        hold => "`hold`",
+        duration => "`duration`",
+        solver => "`solver`",
+        pre => "`pre`",
+        add => "`add`",
+        del => "`del`",
+        segment => "`segment`",
+        primitive => "a primitive like Pw.goal([..])",
+        goal_call => "`.goal(values)`",
+        path_call => "`.path(feature)`",
+        start_state | start_entry => "a start state `Pw [..] Ow .. θsw ..`",
+        axis_pair => "`name: [vector]`",
+        _ => return format!("{rule:?}"),
+    }
+    .to_owned()
+}
+
+fn syntax_error(error: pest::error::Error<Rule>) -> Diagnostic {
+    let span = match error.location {
+        pest::error::InputLocation::Pos(p) => Span { start: p, end: p },
+        pest::error::InputLocation::Span((s, e)) => Span { start: s, end: e },
+    };
+    let message = match &error.variant {
+        pest::error::ErrorVariant::ParsingError { positives, negatives } => {
+            let mut expected: Vec<String> = positives.iter().map(describe).collect();
+            expected.sort();
+            expected.dedup();
+            let list = match expected.as_slice() {
+                [] => String::new(),
+                [one] => one.clone(),
+                [init @ .., last] => format!("{} or {last}", init.join(", ")),
+            };
+            if !list.is_empty() {
+                format!("expected {list}")
+            } else if !negatives.is_empty() {
+                let unexpected: Vec<String> = negatives.iter().map(describe).collect();
+                format!("unexpected {}", unexpected.join(", "))
+            } else {
+                "syntax error".to_owned()
+            }
+        }
+        pest::error::ErrorVariant::CustomError { message } => message.clone(),
+    };
+    Diagnostic::new(span, message)
+}
+
+fn span(node: &Node<'_>) -> Span {
+    let s = node.as_span();
+    Span { start: s.start(), end: s.end() }
+}
+
+fn name(node: Node<'_>) -> Name {
+    Name { span: span(&node), text: node.as_str().to_owned() }
+}
+
+fn string(node: Node<'_>) -> Name {
+    let body = node.into_inner().next();
+    match body {
+        Some(b) => name(b),
+        None => Name { text: String::new(), span: Span::default() },
+    }
+}
+
+fn number(node: &Node<'_>) -> Real {
+    // The grammar only lets digits, a sign, a point and an exponent through.
+    node.as_str().parse().unwrap_or(Real::NAN)
+}
+
+fn quantity(node: Node<'_>) -> ast::Quantity {
+    let sp = span(&node);
+    let mut inner = node.into_inner();
+    let value = inner.next().map(|n| number(&n)).unwrap_or(Real::NAN);
+    ast::Quantity { value, unit: inner.next().map(name), span: sp }
+}
+
+fn vector(node: Node<'_>) -> ast::Vector {
+    let sp = span(&node);
+    let mut values = Vec::new();
+    let mut unit = None;
+    for n in node.into_inner() {
+        match n.as_rule() {
+            Rule::number => values.push(number(&n)),
+            _ => unit = Some(name(n)),
+        }
+    }
+    ast::Vector { values, unit, span: sp }
+}
+
+fn value(node: Node<'_>) -> ast::Value {
+    let node = node.into_inner().next().expect("value has one child");
+    let sp = span(&node);
+    match node.as_rule() {
+        Rule::quantity => ast::Value::Quantity(quantity(node)),
+        Rule::vector => ast::Value::Vector(vector(node)),
+        Rule::rpy => {
+            let mut angles = [0.0; 3];
+            let mut unit = None;
+            let mut i = 0;
+            for n in node.into_inner() {
+                if n.as_rule() == Rule::number {
+                    angles[i] = number(&n);
+                    i += 1;
+                } else {
+                    unit = Some(name(n));
+                }
+            }
+            ast::Value::Rpy { angles, unit, span: sp }
+        }
+        Rule::quat => {
+            let mut wxyz = [0.0; 4];
+            for (i, n) in node.into_inner().enumerate() {
+                wxyz[i] = number(&n);
+            }
+            ast::Value::Quat { wxyz, span: sp }
+        }
+        _ => {
+            let mut pairs = node.into_inner().map(|pair| {
+                let mut inner = pair.into_inner();
+                let key = inner.next().map(name).expect("axis pair has a name");
+                let dir = inner.next().map(vector).expect("axis pair has a vector");
+                (key, dir)
+            });
+            let first = pairs.next().expect("axes has two pairs");
+            let second = pairs.next().expect("axes has two pairs");
+            ast::Value::Axes { pairs: [first, second], span: sp }
+        }
+    }
+}
+
+fn values(node: Node<'_>) -> Vec<ast::Value> {
+    node.into_inner().map(value).collect()
+}
+
+fn variables(node: Node<'_>) -> Vec<Name> {
+    node.into_inner().map(name).collect()
+}
+
+fn facts(node: Node<'_>) -> ast::Facts {
+    let sp = span(&node);
+    ast::Facts { names: node.into_inner().map(name).collect(), span: sp }
+}
+
+fn first_inner(node: Node<'_>) -> Node<'_> {
+    node.into_inner().next().expect("grammar guarantees a child")
+}
+
+fn item(node: Node<'_>) -> ast::Item {
+    match node.as_rule() {
+        Rule::robot => ast::Item::Robot(string(first_inner(node))),
+        Rule::start => ast::Item::Start(start(first_inner(node))),
+        Rule::scene => {
+            let sp = span(&node);
+            ast::Item::Scene(ast::Scene {
+                obstacles: node.into_inner().map(obstacle).collect(),
+                span: sp,
+            })
+        }
+        Rule::settings => {
+            let sp = span(&node);
+            ast::Item::Settings(ast::Settings {
+                entries: node.into_inner().map(setting).collect(),
+                span: sp,
+            })
+        }
+        _ => ast::Item::Task(task(node)),
+    }
+}
+
+fn start(node: Node<'_>) -> ast::Start {
+    match node.as_rule() {
+        Rule::vector => ast::Start::Joints(vector(node)),
+        _ => {
+            let sp = span(&node);
+            let entries = node
+                .into_inner()
+                .map(|entry| {
+                    let mut inner = entry.into_inner();
+                    let var = inner.next().map(name).expect("entry has a variable");
+                    let val = inner.next().map(value).expect("entry has a value");
+                    (var, val)
+                })
+                .collect();
+            ast::Start::State { entries, span: sp }
+        }
+    }
+}
+
+fn obstacle(node: Node<'_>) -> ast::Obstacle {
+    let sp = span(&node);
+    let mut inner = node.into_inner();
+    let obstacle_name = inner.next().map(name).expect("obstacle has a name");
+    let shape_node = first_inner(inner.next().expect("obstacle has a shape"));
+    let rule = shape_node.as_rule();
+    let parts: Vec<Node<'_>> = shape_node.into_inner().collect();
+    let mut vectors = parts.iter().filter(|p| p.as_rule() == Rule::vector).cloned().map(vector);
+    let mut quantities =
+        parts.iter().filter(|p| p.as_rule() == Rule::quantity).cloned().map(quantity);
+    let mut v = || vectors.next().expect("grammar gives the shape's vectors");
+    let mut q = || quantities.next().expect("grammar gives the shape's quantities");
+    let shape = match rule {
+        Rule::box_shape => ast::Shape::Box { at: v(), size: v() },
+        Rule::sphere_shape => ast::Shape::Sphere { at: v(), radius: q() },
+        Rule::capsule_shape => ast::Shape::Capsule { from: v(), to: v(), radius: q() },
+        Rule::cylinder_shape => ast::Shape::Cylinder { at: v(), radius: q(), height: q() },
+        _ => ast::Shape::Unknown(name(parts[0].clone())),
+    };
+    ast::Obstacle { name: obstacle_name, shape, span: sp }
+}
+
+fn setting(node: Node<'_>) -> ast::Setting {
+    let sp = span(&node);
+    let mut inner = node.into_inner();
+    let setting_name = inner.next().map(name).expect("setting has a name");
+    let v = inner.next().expect("setting has a value");
+    let value = match v.as_rule() {
+        Rule::quantity => ast::SettingValue::Quantity(quantity(v)),
+        _ => ast::SettingValue::Word(name(v)),
+    };
+    ast::Setting { name: setting_name, value, span: sp }
+}
+
+fn task(node: Node<'_>) -> ast::Task {
+    let mut inner = node.into_inner();
+    let task_name = inner.next().map(name).expect("task has a name");
+    let mut out = ast::Task {
+        span: task_name.span,
+        name: task_name,
+        init: Vec::new(),
+        goal: Vec::new(),
+        actions: Vec::new(),
+    };
+    for n in inner {
+        match n.as_rule() {
+            Rule::init => out.init.push(facts(first_inner(n))),
+            Rule::task_goal => out.goal.push(facts(first_inner(n))),
+            Rule::action => out.actions.push(action(n)),
+            _ => {} // +Se: actions are sequential whether or not it is written.
+        }
+    }
+    out
+}
+
+fn action(node: Node<'_>) -> ast::Action {
+    let mut inner = node.into_inner();
+    let action_name = inner.next().map(name).expect("action has a name");
+    let mut out = ast::Action {
+        span: action_name.span,
+        name: action_name,
+        description: None,
+        pre: Vec::new(),
+        add: Vec::new(),
+        del: Vec::new(),
+        solver: Vec::new(),
+        body: ast::ActionBody::Constraints {
+            goals: Vec::new(),
+            paths: Vec::new(),
+            durations: Vec::new(),
+        },
+    };
+    for n in inner {
+        match n.as_rule() {
+            Rule::string => out.description = Some(string(n)),
+            Rule::constraint_body => {
+                let (mut goals, mut paths, mut durations) = (Vec::new(), Vec::new(), Vec::new());
+                for s in n.into_inner() {
+                    match s.as_rule() {
+                        Rule::goal => goals.push(goal(s)),
+                        Rule::path => paths.push(path(s)),
+                        Rule::duration => durations.push(quantity(first_inner(s))),
+                        _ => common_statement(&mut out, s),
+                    }
+                }
+                out.body = ast::ActionBody::Constraints { goals, paths, durations };
+            }
+            _ => {
+                let mut segments = Vec::new();
+                for s in n.into_inner() {
+                    match s.as_rule() {
+                        Rule::segment => segments.push(segment(s)),
+                        Rule::tr => {}
+                        _ => common_statement(&mut out, s),
+                    }
+                }
+                out.body = ast::ActionBody::Explicit { segments };
+            }
+        }
+    }
+    out
+}
+
+fn common_statement(action: &mut ast::Action, node: Node<'_>) {
+    match node.as_rule() {
+        Rule::pre => action.pre.push(facts(first_inner(node))),
+        Rule::add => action.add.push(facts(first_inner(node))),
+        Rule::del => action.del.push(facts(first_inner(node))),
+        _ => action.solver.push(name(first_inner(node))),
+    }
+}
+
+fn goal(node: Node<'_>) -> ast::Goal {
+    let sp = span(&node);
+    let terms = node
+        .into_inner()
+        .filter(|n| n.as_rule() == Rule::goal_term)
+        .map(|term| {
+            let tsp = span(&term);
+            let mut inner = term.into_inner();
+            let vars = inner.next().map(variables).unwrap_or_default();
+            let vals = inner.next().map(values).unwrap_or_default();
+            ast::GoalTerm { variables: vars, values: vals, span: tsp }
+        })
+        .collect();
+    ast::Goal { terms, span: Span { start: sp.start, end: sp.start + "goal".len() } }
+}
+
+fn path(node: Node<'_>) -> ast::Path {
+    let sp = span(&node);
+    let mut items = Vec::new();
+    let mut hardness = None;
+    for n in node.into_inner() {
+        match n.as_rule() {
+            Rule::path_item => {
+                let isp = span(&n);
+                let mut inner = n.into_inner();
+                let vars = inner.next().map(variables).unwrap_or_default();
+                let feat = feature(first_inner(inner.next().expect("path item has a feature")));
+                items.push(ast::PathItem { variables: vars, feature: feat, span: isp });
+            }
+            _ => hardness = Some(name(n)),
+        }
+    }
+    ast::Path { items, hardness, span: Span { start: sp.start, end: sp.start + "path".len() } }
+}
+
+fn feature(node: Node<'_>) -> ast::Feature {
+    let rule = node.as_rule();
+    let mut inner = node.into_inner();
+    match rule {
+        Rule::line => ast::Feature::Line {
+            direction: inner.next().map(vector).expect("line has a direction"),
+            size: inner.next().map(quantity),
+        },
+        Rule::about => ast::Feature::About {
+            axis: inner.next().map(name).expect("about has an axis"),
+            size: inner.next().map(quantity),
+        },
+        Rule::by => ast::Feature::By { size: inner.next().map(quantity).expect("by has a size") },
+        _ => ast::Feature::Hold,
+    }
+}
+
+fn segment(node: Node<'_>) -> ast::Segment {
+    let sp = span(&node);
+    let mut duration = None;
+    let mut primitives = Vec::new();
+    let mut combine = ast::Combine::Add;
+    for n in node.into_inner() {
+        match n.as_rule() {
+            Rule::quantity => duration = Some(quantity(n)),
+            Rule::pa => {
+                combine = if n.as_str() == "-Pa" { ast::Combine::Remove } else { ast::Combine::Add }
+            }
+            _ => primitives.push((combine, primitive(n))),
+        }
+    }
+    ast::Segment {
+        duration,
+        primitives,
+        span: Span { start: sp.start, end: sp.start + "segment".len() },
+    }
+}
+
+fn primitive(node: Node<'_>) -> ast::Primitive {
+    let sp = span(&node);
+    let mut inner = node.into_inner();
+    let vars = inner.next().map(variables).unwrap_or_default();
+    let constraint = inner.next().map(|c| match c.as_rule() {
+        Rule::goal_call => ast::PrimitiveConstraint::Goal(c.into_inner().map(value).collect()),
+        Rule::path_call => ast::PrimitiveConstraint::Path(feature(first_inner(c))),
+        _ => ast::PrimitiveConstraint::Hold,
+    });
+    ast::Primitive { variables: vars, constraint, span: sp }
+}

@@ -1,0 +1,429 @@
+//! The validated task: SI units, typed variables, resolved paths. What the
+//! decomposition and the solvers read.
+
+use std::path::PathBuf;
+
+use super::ast::Span;
+use crate::math::{JointVector, Real, Rotation3, Vector3};
+
+/// The two representation spaces (DESIGN.md §3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+pub enum Space {
+    /// (Pw, Ow, θsw).
+    Cpsa,
+    /// (Os, θe, Ow).
+    Hat,
+}
+
+impl Space {
+    /// The space's variables in canonical order.
+    pub fn variables(self) -> [Variable; 3] {
+        match self {
+            Space::Cpsa => [Variable::Pw, Variable::Ow, Variable::Swivel],
+            Space::Hat => [Variable::Os, Variable::Elbow, Variable::Ow],
+        }
+    }
+
+    /// "CPSA" or "HAT".
+    pub fn name(self) -> &'static str {
+        match self {
+            Space::Cpsa => "CPSA",
+            Space::Hat => "HAT",
+        }
+    }
+}
+
+/// The five state variables.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+pub enum Variable {
+    /// Wrist position Pw.
+    Pw,
+    /// Wrist orientation Ow (in both spaces).
+    Ow,
+    /// Swivel angle θsw.
+    Swivel,
+    /// Shoulder frame Os.
+    Os,
+    /// Elbow angle θe.
+    Elbow,
+}
+
+impl Variable {
+    /// Every variable.
+    pub const ALL: [Variable; 5] =
+        [Variable::Pw, Variable::Ow, Variable::Swivel, Variable::Os, Variable::Elbow];
+
+    /// The paper's symbol.
+    pub fn symbol(self) -> &'static str {
+        match self {
+            Variable::Pw => "Pw",
+            Variable::Ow => "Ow",
+            Variable::Swivel => "θsw",
+            Variable::Os => "Os",
+            Variable::Elbow => "θe",
+        }
+    }
+
+    /// The ASCII spelling.
+    pub fn ascii(self) -> &'static str {
+        match self {
+            Variable::Swivel => "sw",
+            Variable::Elbow => "e",
+            other => other.symbol(),
+        }
+    }
+
+    /// Reads a symbol or its ASCII spelling.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|v| v.symbol() == name || v.ascii() == name)
+    }
+
+    /// The space the variable belongs to; `None` for Ow, which is in both.
+    pub fn space(self) -> Option<Space> {
+        match self {
+            Variable::Pw | Variable::Swivel => Some(Space::Cpsa),
+            Variable::Os | Variable::Elbow => Some(Space::Hat),
+            Variable::Ow => None,
+        }
+    }
+
+    /// The kind of value the variable takes.
+    pub fn kind(self) -> ValueKind {
+        match self {
+            Variable::Pw => ValueKind::Position,
+            Variable::Ow | Variable::Os => ValueKind::Rotation,
+            Variable::Swivel | Variable::Elbow => ValueKind::Angle,
+        }
+    }
+}
+
+/// What kind of value a variable takes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum ValueKind {
+    /// A point in {b} (m).
+    Position,
+    /// A rotation in {b}.
+    Rotation,
+    /// An angle (rad).
+    Angle,
+}
+
+/// A goal value of one variable, in SI units and {b}.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub enum Target {
+    /// Pw (m).
+    Position(Vector3),
+    /// Ow or Os.
+    Rotation(Rotation3),
+    /// θsw or θe (rad).
+    Angle(Real),
+}
+
+/// Goals for variables of one space: `Pw Ow = (..)`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Goal {
+    /// Each variable with its target.
+    pub targets: Vec<(Variable, Target)>,
+    /// The space, when the variables fix it (not for Ow alone).
+    pub space: Option<Space>,
+    /// Where it was written.
+    pub span: Span,
+}
+
+/// An action's goal constraint GC: `G` or `G1 ≻ G2`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct GoalConstraint {
+    /// G, or the higher-priority G1.
+    pub primary: Goal,
+    /// G2, lower priority, in another space.
+    pub secondary: Option<Goal>,
+}
+
+/// An axis of a path feature.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub enum Axis {
+    /// A fixed unit direction of {b} (x, y, z and their negations).
+    Base(Vector3),
+    /// A body axis taken at the start of the primitive, with a sign.
+    Body(BodyAxis, Real),
+}
+
+/// Body axes: upper arm r, arm-plane normal l, finger f, palm normal p.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum BodyAxis {
+    /// Upper-arm direction r.
+    R,
+    /// Arm-plane normal l.
+    L,
+    /// Finger direction f.
+    F,
+    /// Palm normal p.
+    P,
+}
+
+/// A path feature P with its size S (SI).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub enum PathFeature {
+    /// Pw along a straight line; the length may be left to Opt2.
+    Line {
+        /// Unit direction in {b}.
+        direction: Vector3,
+        /// Distance (m).
+        length: Option<Real>,
+    },
+    /// Pw, Ow or Os rotating about an axis; the angle may be left to Opt2.
+    About {
+        /// The axis.
+        axis: Axis,
+        /// Angle (rad).
+        angle: Option<Real>,
+    },
+    /// θsw or θe changing by a signed angle (rad).
+    By {
+        /// Angle (rad).
+        angle: Real,
+    },
+    /// Kept constant.
+    Hold,
+}
+
+/// One item of a path constraint.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PathItem {
+    /// Variables that keep the feature.
+    pub variables: Vec<Variable>,
+    /// The feature.
+    pub feature: PathFeature,
+}
+
+/// An action's path constraint PC.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PathConstraint {
+    /// Items, all of one space.
+    pub items: Vec<PathItem>,
+    /// The space (`None` when only Ow is constrained).
+    pub space: Option<Space>,
+    /// Hard (kept exactly) or soft.
+    pub hard: bool,
+    /// Where it was written.
+    pub span: Span,
+}
+
+/// A primitive of an explicit segment.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Primitive {
+    /// Variables it drives.
+    pub variables: Vec<Variable>,
+    /// How.
+    pub constraint: PrimitiveConstraint,
+}
+
+/// The constraint of a primitive.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub enum PrimitiveConstraint {
+    /// Reach these targets (one per variable).
+    Goal(Vec<Target>),
+    /// Keep this feature.
+    Path(PathFeature),
+    /// Keep constant.
+    Hold,
+}
+
+/// An explicit movement segment: primitives covering one space exactly.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Segment {
+    /// Its space.
+    pub space: Space,
+    /// Duration (s), if given.
+    pub duration: Option<Real>,
+    /// Primitives in parallel.
+    pub primitives: Vec<Primitive>,
+}
+
+/// The body of an action.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub enum ActionBody {
+    /// Constraints to decompose.
+    Constraints {
+        /// GC.
+        goal: Option<GoalConstraint>,
+        /// PC.
+        path: Option<PathConstraint>,
+        /// Duration (s), if given.
+        duration: Option<Real>,
+    },
+    /// Segments joined by +Tr.
+    Explicit(Vec<Segment>),
+}
+
+/// Which solver to use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SolverChoice {
+    /// DESIGN.md §5 policy.
+    Auto,
+    /// Velocity QP.
+    Qp,
+    /// RRT-Connect.
+    Rrt,
+    /// Swivel obstacle map.
+    Map,
+    /// Gradient projection baseline.
+    Gpm,
+    /// CLIK baseline.
+    Clik,
+    /// λ0-PMP baseline.
+    Pmp,
+}
+
+impl SolverChoice {
+    /// Every solver with its name.
+    pub const NAMES: [(&'static str, SolverChoice); 7] = [
+        ("auto", SolverChoice::Auto),
+        ("qp", SolverChoice::Qp),
+        ("rrt", SolverChoice::Rrt),
+        ("map", SolverChoice::Map),
+        ("gpm", SolverChoice::Gpm),
+        ("clik", SolverChoice::Clik),
+        ("pmp", SolverChoice::Pmp),
+    ];
+
+    /// The name used in task files.
+    pub fn name(self) -> &'static str {
+        Self::NAMES.iter().find(|(_, s)| *s == self).map_or("auto", |(n, _)| n)
+    }
+}
+
+/// One action of a task.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Action {
+    /// Name.
+    pub name: String,
+    /// Description, if given.
+    pub description: Option<String>,
+    /// STRIPS preconditions.
+    pub pre: Vec<String>,
+    /// STRIPS add effects.
+    pub add: Vec<String>,
+    /// STRIPS delete effects.
+    pub del: Vec<String>,
+    /// Solver for this action, if chosen.
+    pub solver: Option<SolverChoice>,
+    /// Constraints or segments.
+    pub body: ActionBody,
+    /// Where its name was written.
+    pub span: Span,
+}
+
+/// The start of the motion.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub enum Start {
+    /// Joint angles (rad).
+    Joints(JointVector),
+    /// A complete state of one space.
+    State(Vec<(Variable, Target)>),
+}
+
+/// An obstacle's shape, in {b} (or the root frame, per settings), SI.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub enum Shape {
+    /// Axis-aligned box: centre and full edge lengths.
+    Box {
+        /// Centre.
+        center: Vector3,
+        /// Edge lengths.
+        size: Vector3,
+    },
+    /// Sphere.
+    Sphere {
+        /// Centre.
+        center: Vector3,
+        /// Radius.
+        radius: Real,
+    },
+    /// Capsule around a segment.
+    Capsule {
+        /// Segment start.
+        a: Vector3,
+        /// Segment end.
+        b: Vector3,
+        /// Radius.
+        radius: Real,
+    },
+    /// Vertical cylinder.
+    Cylinder {
+        /// Centre.
+        center: Vector3,
+        /// Radius.
+        radius: Real,
+        /// Height.
+        height: Real,
+    },
+}
+
+/// A named obstacle.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Obstacle {
+    /// Unique name.
+    pub name: String,
+    /// Shape.
+    pub shape: Shape,
+}
+
+/// The frame positions are given in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PositionFrame {
+    /// {b}: origin at the shoulder centre (default).
+    Base,
+    /// The URDF root link frame.
+    Root,
+}
+
+/// Task settings with their defaults.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Settings {
+    /// Output rate (Hz), default 100.
+    pub rate: Real,
+    /// Default solver, default auto.
+    pub solver: SolverChoice,
+    /// Seed of randomised solvers, default 0.
+    pub seed: u64,
+    /// Transitional overlap as a fraction of the shorter segment, default 0.2.
+    pub transition: Real,
+    /// Frame of positions, default {b}.
+    pub frame: PositionFrame,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            rate: 100.0,
+            solver: SolverChoice::Auto,
+            seed: 0,
+            transition: 0.2,
+            frame: PositionFrame::Base,
+        }
+    }
+}
+
+/// A validated A2ML task.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Task {
+    /// The task's name.
+    pub name: String,
+    /// The robot URDF, resolved relative to the task file.
+    pub robot: PathBuf,
+    /// The start, if given.
+    pub start: Option<Start>,
+    /// Obstacles.
+    pub scene: Vec<Obstacle>,
+    /// Settings.
+    pub settings: Settings,
+    /// STRIPS initial facts, when the planner orders the actions.
+    pub init: Option<Vec<String>>,
+    /// STRIPS goal facts.
+    pub goal: Option<Vec<String>>,
+    /// Actions in written order.
+    pub actions: Vec<Action>,
+}

@@ -1,0 +1,990 @@
+//! Syntax tree to [`Task`]: units to SI, every variable checked against its
+//! space, segments checked for coverage, names resolved. Collects every
+//! problem rather than stopping at the first.
+
+use std::collections::{BTreeSet, HashMap};
+use std::path::{Path, PathBuf};
+
+use super::ast::{self, Name, Span};
+use super::diagnostic::Diagnostic;
+use super::task::*;
+use crate::math::{DOF, JointVector, Matrix3, PI, Real, Rotation3, UnitQuaternion, Vector3};
+use crate::names::did_you_mean;
+
+/// Physical dimension of a quantity.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Dimension {
+    Length,
+    Angle,
+    Time,
+    Fraction,
+    Frequency,
+}
+
+impl Dimension {
+    fn describe(self) -> &'static str {
+        match self {
+            Dimension::Length => "a length (m, cm, mm)",
+            Dimension::Angle => "an angle (deg, rad)",
+            Dimension::Time => "a time (s, ms)",
+            Dimension::Fraction => "a fraction (%)",
+            Dimension::Frequency => "a frequency (Hz)",
+        }
+    }
+}
+
+const UNITS: [(&str, Dimension, Real); 10] = [
+    ("m", Dimension::Length, 1.0),
+    ("cm", Dimension::Length, 0.01),
+    ("mm", Dimension::Length, 0.001),
+    ("rad", Dimension::Angle, 1.0),
+    ("deg", Dimension::Angle, PI / 180.0),
+    ("°", Dimension::Angle, PI / 180.0),
+    ("s", Dimension::Time, 1.0),
+    ("ms", Dimension::Time, 0.001),
+    ("%", Dimension::Fraction, 0.01),
+    ("Hz", Dimension::Frequency, 1.0),
+];
+
+const AXES: [&str; 14] =
+    ["x", "y", "z", "-x", "-y", "-z", "r", "l", "f", "p", "-r", "-l", "-f", "-p"];
+const SHAPES: [&str; 4] = ["box", "sphere", "capsule", "cylinder"];
+const SETTINGS: [&str; 5] = ["rate", "solver", "seed", "transition", "frame"];
+
+struct Checker<'a> {
+    errors: Vec<Diagnostic>,
+    base_dir: Option<&'a Path>,
+}
+
+fn variable_names() -> impl Iterator<Item = &'static str> {
+    Variable::ALL.into_iter().flat_map(|v| [v.symbol(), v.ascii()])
+}
+
+fn list(vars: &[Variable]) -> String {
+    vars.iter().map(|v| v.symbol()).collect::<Vec<_>>().join(", ")
+}
+
+impl Checker<'_> {
+    fn error(&mut self, span: Span, message: impl Into<String>) {
+        self.errors.push(Diagnostic::new(span, message));
+    }
+
+    fn error_with_help(&mut self, span: Span, message: impl Into<String>, help: Option<String>) {
+        let mut d = Diagnostic::new(span, message);
+        d.help = help;
+        self.errors.push(d);
+    }
+
+    /// The factor of a written unit for `dimension`; errors name the problem.
+    fn unit_factor(&mut self, unit: &Option<Name>, dimension: Dimension) -> Option<Real> {
+        let Some(unit) = unit else { return Some(1.0) };
+        match UNITS.iter().find(|(n, ..)| *n == unit.text) {
+            Some((_, d, f)) if *d == dimension => Some(*f),
+            Some((_, d, _)) => {
+                self.error(
+                    unit.span,
+                    format!(
+                        "`{}` is {}, but {} is expected here",
+                        unit.text,
+                        d.describe(),
+                        dimension.describe()
+                    ),
+                );
+                None
+            }
+            None => {
+                let help = did_you_mean(&unit.text, UNITS.iter().map(|(n, ..)| *n))
+                    .map(|s| format!("did you mean `{s}`?"));
+                self.error_with_help(unit.span, format!("unknown unit `{}`", unit.text), help);
+                None
+            }
+        }
+    }
+
+    fn quantity(&mut self, q: &ast::Quantity, dimension: Dimension) -> Option<Real> {
+        let f = self.unit_factor(&q.unit, dimension)?;
+        let v = q.value * f;
+        if !v.is_finite() {
+            self.error(q.span, "the number is too large");
+            return None;
+        }
+        Some(v)
+    }
+
+    fn positive(&mut self, q: &ast::Quantity, dimension: Dimension, what: &str) -> Option<Real> {
+        let v = self.quantity(q, dimension)?;
+        if v <= 0.0 {
+            self.error(q.span, format!("{what} must be positive"));
+            return None;
+        }
+        Some(v)
+    }
+
+    fn numbers(
+        &mut self,
+        v: &ast::Vector,
+        dimension: Dimension,
+        len: usize,
+        what: &str,
+    ) -> Option<Vec<Real>> {
+        let f = self.unit_factor(&v.unit, dimension)?;
+        if v.values.len() != len {
+            self.error(
+                v.span,
+                format!("{what} needs {len} numbers, but {} are given", v.values.len()),
+            );
+            return None;
+        }
+        let out: Vec<Real> = v.values.iter().map(|x| x * f).collect();
+        if out.iter().any(|x| !x.is_finite()) {
+            self.error(v.span, "a number is too large");
+            return None;
+        }
+        Some(out)
+    }
+
+    fn vector3(&mut self, v: &ast::Vector, dimension: Dimension, what: &str) -> Option<Vector3> {
+        self.numbers(v, dimension, 3, what).map(|n| Vector3::new(n[0], n[1], n[2]))
+    }
+
+    fn direction(&mut self, v: &ast::Vector, what: &str) -> Option<Vector3> {
+        if let Some(unit) = &v.unit {
+            self.error(unit.span, format!("{what} is a direction and takes no unit"));
+            return None;
+        }
+        let d = self.vector3(v, Dimension::Length, what)?;
+        match d.try_normalize(1e-12) {
+            Some(d) => Some(d),
+            None => {
+                self.error(v.span, format!("{what} must not be zero"));
+                None
+            }
+        }
+    }
+
+    fn variable(&mut self, name: &Name) -> Option<Variable> {
+        let v = Variable::from_name(&name.text);
+        if v.is_none() {
+            let help = did_you_mean(&name.text, variable_names())
+                .map(|s| format!("did you mean `{s}`?"))
+                .or_else(|| Some("the state variables are Pw, Ow, θsw (sw), Os and θe (e)".into()));
+            self.error_with_help(
+                name.span,
+                format!("unknown state variable `{}`", name.text),
+                help,
+            );
+        }
+        v
+    }
+
+    /// Variables of one term, distinct and of one space.
+    fn variables(&mut self, names: &[Name]) -> Option<(Vec<Variable>, Option<Space>)> {
+        let mut vars = Vec::new();
+        let mut ok = true;
+        for n in names {
+            match self.variable(n) {
+                Some(v) if vars.contains(&v) => {
+                    self.error(n.span, format!("{} is named twice", v.symbol()));
+                    ok = false;
+                }
+                Some(v) => vars.push(v),
+                None => ok = false,
+            }
+        }
+        if !ok {
+            return None;
+        }
+        let space = self.space_of(names, &vars)?;
+        Some((vars, space))
+    }
+
+    /// The one space of `vars` (None when only Ow); an error if mixed.
+    fn space_of(&mut self, names: &[Name], vars: &[Variable]) -> Option<Option<Space>> {
+        let mut space: Option<(Space, Variable)> = None;
+        for (n, v) in names.iter().zip(vars) {
+            if let Some(s) = v.space() {
+                match space {
+                    Some((t, first)) if t != s => {
+                        self.error(
+                            n.span,
+                            format!(
+                                "{} belongs to {} space, but {} belongs to {} space; \
+                                 one constraint covers one space",
+                                v.symbol(),
+                                s.name(),
+                                first.symbol(),
+                                t.name()
+                            ),
+                        );
+                        return None;
+                    }
+                    None => space = Some((s, *v)),
+                    _ => {}
+                }
+            }
+        }
+        Some(space.map(|(s, _)| s))
+    }
+
+    fn rotation(&mut self, value: &ast::Value, keys: [&str; 2], what: &str) -> Option<Rotation3> {
+        match value {
+            ast::Value::Rpy { angles, unit, .. } => {
+                let f = self.unit_factor(unit, Dimension::Angle)?;
+                Some(Rotation3::from_euler_angles(angles[0] * f, angles[1] * f, angles[2] * f))
+            }
+            ast::Value::Quat { wxyz, span } => {
+                let q = nalgebra::Quaternion::new(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
+                if !(q.norm() > 1e-9 && q.norm().is_finite()) {
+                    self.error(*span, "a quaternion must not be zero");
+                    return None;
+                }
+                Some(UnitQuaternion::from_quaternion(q).to_rotation_matrix())
+            }
+            ast::Value::Axes { pairs, span } => self.axes(pairs, *span, keys, what),
+            other => {
+                self.error(
+                    other.span(),
+                    format!(
+                        "{what} is a rotation: rpy(..), quat(..) or axes({}: .., {}: ..)",
+                        keys[0], keys[1]
+                    ),
+                );
+                None
+            }
+        }
+    }
+
+    /// A rotation from two named directions: columns k0, k1, k0 × k1.
+    fn axes(
+        &mut self,
+        pairs: &[(Name, ast::Vector); 2],
+        span: Span,
+        keys: [&str; 2],
+        what: &str,
+    ) -> Option<Rotation3> {
+        let mut found: [Option<Vector3>; 2] = [None, None];
+        for (key, vector) in pairs {
+            let Some(i) = keys.iter().position(|k| *k == key.text) else {
+                let help = did_you_mean(&key.text, keys).map(|s| format!("did you mean `{s}`?"));
+                self.error_with_help(
+                    key.span,
+                    format!(
+                        "{what} is given by axes `{}` and `{}`, not `{}`",
+                        keys[0], keys[1], key.text
+                    ),
+                    help,
+                );
+                return None;
+            };
+            if found[i].is_some() {
+                self.error(key.span, format!("axis `{}` is given twice", key.text));
+                return None;
+            }
+            found[i] = Some(self.direction(vector, &format!("axis `{}`", key.text))?);
+        }
+        let (a, b) = (found[0]?, found[1]?);
+        let cos = a.dot(&b);
+        if cos.abs() > 0.01 {
+            self.error(
+                span,
+                format!(
+                    "axes `{}` and `{}` must be orthogonal, but they are {:.1}° apart",
+                    keys[0],
+                    keys[1],
+                    cos.clamp(-1.0, 1.0).acos().to_degrees()
+                ),
+            );
+            return None;
+        }
+        // Rounded inputs such as 0.707 are squared up, keeping the first axis.
+        let b = (b - a * cos).normalize();
+        Some(Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[a, b, a.cross(&b)])))
+    }
+
+    fn target(&mut self, var: Variable, value: &ast::Value) -> Option<Target> {
+        match var.kind() {
+            ValueKind::Position => match value {
+                ast::Value::Vector(v) => {
+                    self.vector3(v, Dimension::Length, "Pw").map(Target::Position)
+                }
+                other => {
+                    self.error(other.span(), "Pw is a position: a vector like [0.3, -0.1, 0.05]");
+                    None
+                }
+            },
+            ValueKind::Rotation => {
+                let keys = if var == Variable::Os { ["r", "l"] } else { ["f", "p"] };
+                self.rotation(value, keys, var.symbol()).map(Target::Rotation)
+            }
+            ValueKind::Angle => match value {
+                ast::Value::Quantity(q) => self.quantity(q, Dimension::Angle).map(Target::Angle),
+                other => {
+                    self.error(other.span(), format!("{} is an angle like 30 deg", var.symbol()));
+                    None
+                }
+            },
+        }
+    }
+
+    fn targets(
+        &mut self,
+        vars: &[Variable],
+        values: &[ast::Value],
+        span: Span,
+    ) -> Option<Vec<Target>> {
+        if vars.len() != values.len() {
+            self.error(
+                span,
+                format!(
+                    "{} variable{} ({}) but {} value{}",
+                    vars.len(),
+                    if vars.len() == 1 { "" } else { "s" },
+                    list(vars),
+                    values.len(),
+                    if values.len() == 1 { "" } else { "s" }
+                ),
+            );
+            return None;
+        }
+        let out: Vec<Option<Target>> =
+            vars.iter().zip(values).map(|(v, x)| self.target(*v, x)).collect();
+        out.into_iter().collect()
+    }
+
+    fn goal_term(&mut self, term: &ast::GoalTerm) -> Option<Goal> {
+        let (vars, space) = self.variables(&term.variables)?;
+        let targets = self.targets(&vars, &term.values, term.span)?;
+        Some(Goal { targets: vars.into_iter().zip(targets).collect(), space, span: term.span })
+    }
+
+    fn goal(&mut self, goal: &ast::Goal) -> Option<GoalConstraint> {
+        let terms: Vec<Option<Goal>> = goal.terms.iter().map(|t| self.goal_term(t)).collect();
+        let mut terms = terms.into_iter().collect::<Option<Vec<Goal>>>()?.into_iter();
+        let primary = terms.next()?;
+        let secondary = terms.next();
+        if let Some(second) = &secondary {
+            if let (Some(a), Some(b)) = (primary.space, second.space) {
+                if a == b {
+                    self.error(
+                        second.span,
+                        format!(
+                            "both goals are in {} space; `>` orders goals of different spaces \
+                             (write one goal `{}` for goals of one space)",
+                            a.name(),
+                            "V1 V2 = (v1, v2)"
+                        ),
+                    );
+                    return None;
+                }
+            }
+            if let Some((v, _)) =
+                second.targets.iter().find(|(v, _)| primary.targets.iter().any(|(p, _)| p == v))
+            {
+                self.error(second.span, format!("{} appears in both goals", v.symbol()));
+                return None;
+            }
+        }
+        Some(GoalConstraint { primary, secondary })
+    }
+
+    fn axis(&mut self, name: &Name) -> Option<Axis> {
+        let (sign, bare) = match name.text.strip_prefix('-') {
+            Some(rest) => (-1.0, rest),
+            None => (1.0, name.text.as_str()),
+        };
+        let axis = match bare {
+            "x" => Axis::Base(Vector3::x() * sign),
+            "y" => Axis::Base(Vector3::y() * sign),
+            "z" => Axis::Base(Vector3::z() * sign),
+            "r" => Axis::Body(BodyAxis::R, sign),
+            "l" => Axis::Body(BodyAxis::L, sign),
+            "f" => Axis::Body(BodyAxis::F, sign),
+            "p" => Axis::Body(BodyAxis::P, sign),
+            _ => {
+                let help = did_you_mean(&name.text, AXES).map(|s| format!("did you mean `{s}`?"));
+                self.error_with_help(
+                    name.span,
+                    format!("unknown axis `{}`: axes are x, y, z of {{b}} (or -x, -y, -z) and r, l, f, p of the arm", name.text),
+                    help,
+                );
+                return None;
+            }
+        };
+        Some(axis)
+    }
+
+    /// A feature for `vars`, checking that each variable can keep it.
+    fn feature(
+        &mut self,
+        vars: &[Variable],
+        names: &[Name],
+        feature: &ast::Feature,
+    ) -> Option<PathFeature> {
+        let (allowed, what): (&[Variable], &str) = match feature {
+            ast::Feature::Line { .. } => (&[Variable::Pw], "`line` moves Pw"),
+            ast::Feature::About { .. } => {
+                (&[Variable::Pw, Variable::Ow, Variable::Os], "`about` turns Pw, Ow or Os")
+            }
+            ast::Feature::By { .. } => {
+                (&[Variable::Swivel, Variable::Elbow], "`by` changes θsw or θe")
+            }
+            ast::Feature::Hold => (&Variable::ALL, ""),
+        };
+        for (v, n) in vars.iter().zip(names) {
+            if !allowed.contains(v) {
+                self.error(n.span, format!("{what}, not {}", v.symbol()));
+                return None;
+            }
+        }
+        Some(match feature {
+            ast::Feature::Line { direction, size } => PathFeature::Line {
+                direction: self.direction(direction, "the line direction")?,
+                length: match size {
+                    Some(q) => Some(self.positive(q, Dimension::Length, "the line length")?),
+                    None => None,
+                },
+            },
+            ast::Feature::About { axis, size } => PathFeature::About {
+                axis: self.axis(axis)?,
+                angle: match size {
+                    Some(q) => {
+                        Some(self.positive(q, Dimension::Angle, "the angle about an axis")?)
+                    }
+                    None => None,
+                },
+            },
+            ast::Feature::By { size } => {
+                let angle = self.quantity(size, Dimension::Angle)?;
+                if angle == 0.0 {
+                    self.error(size.span, "`by` needs a non-zero angle (use `hold` to keep it)");
+                    return None;
+                }
+                PathFeature::By { angle }
+            }
+            ast::Feature::Hold => PathFeature::Hold,
+        })
+    }
+
+    fn path(&mut self, path: &ast::Path) -> Option<PathConstraint> {
+        let mut items = Vec::new();
+        let mut all_vars: Vec<Variable> = Vec::new();
+        let mut all_names: Vec<Name> = Vec::new();
+        let mut ok = true;
+        for item in &path.items {
+            let Some((vars, _)) = self.variables(&item.variables) else {
+                ok = false;
+                continue;
+            };
+            for (v, n) in vars.iter().zip(&item.variables) {
+                if all_vars.contains(v) {
+                    self.error(n.span, format!("{} is constrained twice in this path", v.symbol()));
+                    ok = false;
+                }
+            }
+            all_vars.extend(&vars);
+            all_names.extend(item.variables.iter().cloned());
+            match self.feature(&vars, &item.variables, &item.feature) {
+                Some(feature) => items.push(PathItem { variables: vars, feature }),
+                None => ok = false,
+            }
+        }
+        let space = self.space_of(&all_names, &all_vars)?;
+        let hard = match &path.hardness {
+            None => true,
+            Some(h) if h.text == "hard" => true,
+            Some(h) if h.text == "soft" => false,
+            Some(h) => {
+                self.error(h.span, format!("expected `hard` or `soft`, found `{}`", h.text));
+                return None;
+            }
+        };
+        ok.then_some(PathConstraint { items, space, hard, span: path.span })
+    }
+
+    fn solver(&mut self, name: &Name) -> Option<SolverChoice> {
+        let found = SolverChoice::NAMES.iter().find(|(n, _)| *n == name.text).map(|(_, s)| *s);
+        if found.is_none() {
+            let help = did_you_mean(&name.text, SolverChoice::NAMES.iter().map(|(n, _)| *n))
+                .map(|s| format!("did you mean `{s}`?"));
+            self.error_with_help(
+                name.span,
+                format!("unknown solver `{}` (auto, qp, rrt, map, gpm, clik, pmp)", name.text),
+                help,
+            );
+        }
+        found
+    }
+
+    fn segment(&mut self, segment: &ast::Segment) -> Option<Segment> {
+        let mut primitives: Vec<Primitive> = Vec::new();
+        let mut names: Vec<Name> = Vec::new();
+        let mut vars_seen: Vec<Variable> = Vec::new();
+        let mut ok = true;
+        for (combine, p) in &segment.primitives {
+            let Some((vars, _)) = self.variables(&p.variables) else {
+                ok = false;
+                continue;
+            };
+            match (combine, &p.constraint) {
+                (ast::Combine::Add, None) => {
+                    self.error(p.span, "a primitive needs `.goal(..)`, `.path(..)` or `.hold`");
+                    ok = false;
+                }
+                (ast::Combine::Add, Some(c)) => {
+                    for (v, n) in vars.iter().zip(&p.variables) {
+                        if vars_seen.contains(v) {
+                            self.error(
+                                n.span,
+                                format!("{} is already driven in this segment", v.symbol()),
+                            );
+                            ok = false;
+                        }
+                    }
+                    let constraint = match c {
+                        ast::PrimitiveConstraint::Goal(values) => {
+                            self.targets(&vars, values, p.span).map(PrimitiveConstraint::Goal)
+                        }
+                        ast::PrimitiveConstraint::Path(f) => {
+                            self.feature(&vars, &p.variables, f).map(PrimitiveConstraint::Path)
+                        }
+                        ast::PrimitiveConstraint::Hold => Some(PrimitiveConstraint::Hold),
+                    };
+                    match constraint {
+                        Some(constraint) => {
+                            vars_seen.extend(&vars);
+                            names.extend(p.variables.iter().cloned());
+                            primitives.push(Primitive { variables: vars, constraint });
+                        }
+                        None => ok = false,
+                    }
+                }
+                (ast::Combine::Remove, Some(_)) => {
+                    self.error(p.span, "`-Pa` removes variables: write them without a constraint");
+                    ok = false;
+                }
+                (ast::Combine::Remove, None) => {
+                    for (v, n) in vars.iter().zip(&p.variables) {
+                        let Some(i) = vars_seen.iter().position(|s| s == v) else {
+                            self.error(
+                                n.span,
+                                format!(
+                                    "{} is not driven here, so `-Pa` cannot remove it",
+                                    v.symbol()
+                                ),
+                            );
+                            ok = false;
+                            continue;
+                        };
+                        vars_seen.remove(i);
+                        names.remove(i);
+                        for prim in &mut primitives {
+                            if let Some(k) = prim.variables.iter().position(|x| x == v) {
+                                prim.variables.remove(k);
+                                if let PrimitiveConstraint::Goal(t) = &mut prim.constraint {
+                                    t.remove(k);
+                                }
+                            }
+                        }
+                        primitives.retain(|p| !p.variables.is_empty());
+                    }
+                }
+            }
+        }
+        if !ok {
+            return None;
+        }
+        let space = match self.space_of(&names, &vars_seen)? {
+            Some(s) => s,
+            None => {
+                self.error(
+                    segment.span,
+                    "a segment covers a whole space: Pw, Ow, θsw (CPSA) or Os, θe, Ow (HAT)",
+                );
+                return None;
+            }
+        };
+        let missing: Vec<Variable> =
+            space.variables().into_iter().filter(|v| !vars_seen.contains(v)).collect();
+        if !missing.is_empty() {
+            self.error(
+                segment.span,
+                format!(
+                    "this {} segment does not drive {}: a segment covers {} exactly once",
+                    space.name(),
+                    list(&missing),
+                    list(&space.variables())
+                ),
+            );
+            return None;
+        }
+        let duration = match &segment.duration {
+            Some(q) => Some(self.positive(q, Dimension::Time, "a segment's duration")?),
+            None => None,
+        };
+        Some(Segment { space, duration, primitives })
+    }
+
+    fn facts(&mut self, lists: &[ast::Facts], what: &str) -> Vec<String> {
+        if let Some(extra) = lists.get(1) {
+            self.error(extra.span, format!("`{what}` is given twice"));
+        }
+        let mut out: Vec<String> = Vec::new();
+        for n in lists.iter().flat_map(|f| &f.names) {
+            if out.contains(&n.text) {
+                self.error(n.span, format!("fact `{}` is listed twice", n.text));
+            } else {
+                out.push(n.text.clone());
+            }
+        }
+        out
+    }
+
+    fn action(&mut self, a: &ast::Action) -> Option<Action> {
+        let pre = self.facts(&a.pre, "pre");
+        let add = self.facts(&a.add, "add");
+        let del = self.facts(&a.del, "del");
+        if let Some(extra) = a.solver.get(1) {
+            self.error(extra.span, "`solver` is given twice");
+        }
+        let solver = a.solver.first().and_then(|s| self.solver(s));
+        let body = match &a.body {
+            ast::ActionBody::Constraints { goals, paths, durations } => {
+                for g in goals.iter().skip(1) {
+                    self.error(g.span, "an action has one `goal`; order two goals with `>` in it");
+                }
+                for p in paths.iter().skip(1) {
+                    self.error(
+                        p.span,
+                        "an action has one `path`; list several variables in it with `,`",
+                    );
+                }
+                for d in durations.iter().skip(1) {
+                    self.error(d.span, "`duration` is given twice");
+                }
+                if goals.is_empty() && paths.is_empty() {
+                    self.error(
+                        a.name.span,
+                        format!("action `{}` has neither a goal nor a path", a.name.text),
+                    );
+                }
+                let goal = goals.first().map(|g| self.goal(g));
+                let path = paths.first().map(|p| self.path(p));
+                let duration =
+                    durations.first().map(|d| self.positive(d, Dimension::Time, "the duration"));
+                ActionBody::Constraints {
+                    goal: goal.flatten(),
+                    path: path.flatten(),
+                    duration: duration.flatten(),
+                }
+            }
+            ast::ActionBody::Explicit { segments } => {
+                let segs: Vec<Option<Segment>> = segments.iter().map(|s| self.segment(s)).collect();
+                ActionBody::Explicit(segs.into_iter().flatten().collect())
+            }
+        };
+        Some(Action {
+            name: a.name.text.clone(),
+            description: a.description.as_ref().map(|d| d.text.clone()),
+            pre,
+            add,
+            del,
+            solver,
+            body,
+            span: a.name.span,
+        })
+    }
+
+    fn start(&mut self, start: &ast::Start) -> Option<Start> {
+        match start {
+            ast::Start::Joints(v) => {
+                let q = self.numbers(v, Dimension::Angle, DOF, "the start configuration")?;
+                Some(Start::Joints(JointVector::from_column_slice(&q)))
+            }
+            ast::Start::State { entries, span } => {
+                let names: Vec<Name> = entries.iter().map(|(n, _)| n.clone()).collect();
+                let (vars, space) = self.variables(&names)?;
+                let targets: Vec<Option<Target>> =
+                    vars.iter().zip(entries).map(|(v, (_, x))| self.target(*v, x)).collect();
+                let targets: Vec<Target> = targets.into_iter().collect::<Option<_>>()?;
+                let space = space.unwrap_or(Space::Cpsa);
+                let missing: Vec<Variable> =
+                    space.variables().into_iter().filter(|v| !vars.contains(v)).collect();
+                if !missing.is_empty() {
+                    self.error(
+                        *span,
+                        format!(
+                            "a start state in {} space also needs {}",
+                            space.name(),
+                            list(&missing)
+                        ),
+                    );
+                    return None;
+                }
+                Some(Start::State(vars.into_iter().zip(targets).collect()))
+            }
+        }
+    }
+
+    fn scene(&mut self, scene: &ast::Scene) -> Vec<Obstacle> {
+        let mut seen: HashMap<&str, Span> = HashMap::new();
+        let mut out = Vec::new();
+        for o in &scene.obstacles {
+            if seen.insert(&o.name.text, o.name.span).is_some() {
+                self.error(o.name.span, format!("obstacle `{}` is declared twice", o.name.text));
+                continue;
+            }
+            let shape = match &o.shape {
+                ast::Shape::Box { at, size } => (|| {
+                    let center = self.vector3(at, Dimension::Length, "the centre")?;
+                    let size = self.vector3(size, Dimension::Length, "the size")?;
+                    if size.iter().any(|s| *s <= 0.0) {
+                        self.error(o.span, "a box's size must be positive in x, y and z");
+                        return None;
+                    }
+                    Some(Shape::Box { center, size })
+                })(),
+                ast::Shape::Sphere { at, radius } => (|| {
+                    Some(Shape::Sphere {
+                        center: self.vector3(at, Dimension::Length, "the centre")?,
+                        radius: self.positive(radius, Dimension::Length, "the radius")?,
+                    })
+                })(),
+                ast::Shape::Capsule { from, to, radius } => (|| {
+                    Some(Shape::Capsule {
+                        a: self.vector3(from, Dimension::Length, "the start")?,
+                        b: self.vector3(to, Dimension::Length, "the end")?,
+                        radius: self.positive(radius, Dimension::Length, "the radius")?,
+                    })
+                })(),
+                ast::Shape::Cylinder { at, radius, height } => (|| {
+                    Some(Shape::Cylinder {
+                        center: self.vector3(at, Dimension::Length, "the centre")?,
+                        radius: self.positive(radius, Dimension::Length, "the radius")?,
+                        height: self.positive(height, Dimension::Length, "the height")?,
+                    })
+                })(),
+                ast::Shape::Unknown(name) => {
+                    let help =
+                        did_you_mean(&name.text, SHAPES).map(|s| format!("did you mean `{s}`?"));
+                    self.error_with_help(
+                        name.span,
+                        format!("unknown shape `{}` (box, sphere, capsule, cylinder)", name.text),
+                        help,
+                    );
+                    None
+                }
+            };
+            if let Some(shape) = shape {
+                out.push(Obstacle { name: o.name.text.clone(), shape });
+            }
+        }
+        out
+    }
+
+    fn settings(&mut self, settings: &ast::Settings) -> Settings {
+        let mut out = Settings::default();
+        let mut seen: BTreeSet<&str> = BTreeSet::new();
+        for s in &settings.entries {
+            if !seen.insert(&s.name.text) && SETTINGS.contains(&s.name.text.as_str()) {
+                self.error(s.name.span, format!("setting `{}` is given twice", s.name.text));
+                continue;
+            }
+            match (s.name.text.as_str(), &s.value) {
+                ("rate", ast::SettingValue::Quantity(q)) => {
+                    if let Some(v) = self.positive(q, Dimension::Frequency, "the rate") {
+                        out.rate = v;
+                    }
+                }
+                ("solver", ast::SettingValue::Word(w)) => {
+                    if let Some(v) = self.solver(w) {
+                        out.solver = v;
+                    }
+                }
+                ("seed", ast::SettingValue::Quantity(q)) => {
+                    if q.unit.is_some()
+                        || q.value < 0.0
+                        || q.value.fract() != 0.0
+                        || q.value > 9.0e15
+                    {
+                        self.error(q.span, "the seed is a non-negative whole number");
+                    } else {
+                        out.seed = q.value as u64;
+                    }
+                }
+                ("transition", ast::SettingValue::Quantity(q)) => {
+                    if let Some(v) = self.quantity(q, Dimension::Fraction) {
+                        if (0.0..1.0).contains(&v) {
+                            out.transition = v;
+                        } else {
+                            self.error(q.span, "the transition overlap is between 0 and 100 %");
+                        }
+                    }
+                }
+                ("frame", ast::SettingValue::Word(w)) => match w.text.as_str() {
+                    "base" => out.frame = PositionFrame::Base,
+                    "root" => out.frame = PositionFrame::Root,
+                    _ => self
+                        .error(w.span, format!("the frame is `base` or `root`, not `{}`", w.text)),
+                },
+                (name @ ("rate" | "solver" | "seed" | "transition" | "frame"), value) => {
+                    let span = match value {
+                        ast::SettingValue::Quantity(q) => q.span,
+                        ast::SettingValue::Word(w) => w.span,
+                    };
+                    let expected = match name {
+                        "rate" => "a rate like 100 Hz",
+                        "solver" => "a solver name like qp",
+                        "seed" => "a whole number",
+                        "transition" => "a percentage like 20 %",
+                        _ => "`base` or `root`",
+                    };
+                    self.error(span, format!("`{name}` takes {expected}"));
+                }
+                (other, _) => {
+                    let help =
+                        did_you_mean(other, SETTINGS).map(|s| format!("did you mean `{s}`?"));
+                    self.error_with_help(
+                        s.name.span,
+                        format!(
+                            "unknown setting `{other}` (rate, solver, seed, transition, frame)"
+                        ),
+                        help,
+                    );
+                }
+            }
+        }
+        out
+    }
+
+    fn robot(&mut self, name: &Name) -> Option<PathBuf> {
+        let written = Path::new(&name.text);
+        let resolved = match self.base_dir {
+            Some(dir) if written.is_relative() => dir.join(written),
+            _ => written.to_path_buf(),
+        };
+        if !resolved.is_file() {
+            self.error(name.span, format!("robot file not found: {}", resolved.display()));
+            return None;
+        }
+        Some(resolved)
+    }
+
+    /// STRIPS: every fact an action needs or deletes, and every goal fact,
+    /// is in `init` or added by some action.
+    fn strips(&mut self, task: &ast::Task, init: &[String]) {
+        let mut known: Vec<&str> = init.iter().map(String::as_str).collect();
+        for a in &task.actions {
+            known.extend(a.add.iter().flat_map(|f| &f.names).map(|n| n.text.as_str()));
+        }
+        let needed = task
+            .actions
+            .iter()
+            .flat_map(|a| a.pre.iter().chain(&a.del))
+            .chain(&task.goal)
+            .flat_map(|f| &f.names);
+        for n in needed {
+            if !known.contains(&n.text.as_str()) {
+                let help = did_you_mean(&n.text, known.iter().copied())
+                    .map(|s| format!("did you mean `{s}`?"));
+                self.error_with_help(
+                    n.span,
+                    format!(
+                        "fact `{}` is never true: it is not in `init` and no action adds it",
+                        n.text
+                    ),
+                    help,
+                );
+            }
+        }
+    }
+}
+
+/// Validates a parsed file. `base_dir` is the task file's folder, against
+/// which the robot path is resolved.
+pub(super) fn validate(file: &ast::File, base_dir: Option<&Path>) -> Result<Task, Vec<Diagnostic>> {
+    let mut c = Checker { errors: Vec::new(), base_dir };
+    let mut robot: Option<PathBuf> = None;
+    let (mut seen_robot, mut start, mut scene, mut settings) = (false, None, Vec::new(), None);
+    let mut tasks: Vec<&ast::Task> = Vec::new();
+    let mut seen_start = false;
+    let mut seen_scene = false;
+    for item in &file.items {
+        match item {
+            ast::Item::Robot(name) => {
+                if seen_robot {
+                    c.error(name.span, "a file names one `robot`");
+                }
+                seen_robot = true;
+                robot = c.robot(name).or(robot);
+            }
+            ast::Item::Start(s) => {
+                if seen_start {
+                    let span = match s {
+                        ast::Start::Joints(v) => v.span,
+                        ast::Start::State { span, .. } => *span,
+                    };
+                    c.error(span, "a file has one `start`");
+                }
+                seen_start = true;
+                start = c.start(s);
+            }
+            ast::Item::Scene(s) => {
+                if seen_scene {
+                    c.error(s.span, "a file has one `scene`");
+                }
+                seen_scene = true;
+                scene.extend(c.scene(s));
+            }
+            ast::Item::Settings(s) => {
+                if settings.is_some() {
+                    c.error(s.span, "a file has one `settings`");
+                }
+                settings = Some(c.settings(s));
+            }
+            ast::Item::Task(t) => tasks.push(t),
+        }
+    }
+    if !seen_robot {
+        c.error(Span::default(), "the file names no robot: add `robot \"path/to/arm.urdf\"`");
+    }
+    for extra in tasks.iter().skip(1) {
+        c.error(extra.name.span, "a file holds one `task`");
+    }
+    let Some(task) = tasks.first() else {
+        c.error(Span { start: 0, end: 0 }, "the file has no `task`");
+        return Err(c.errors);
+    };
+    let mut action_names: HashMap<&str, Span> = HashMap::new();
+    for a in &task.actions {
+        if action_names.insert(&a.name.text, a.name.span).is_some() {
+            c.error(a.name.span, format!("action `{}` is declared twice", a.name.text));
+        }
+    }
+    let actions: Vec<Action> = task.actions.iter().filter_map(|a| c.action(a)).collect();
+    let init = c.facts(&task.init, "init");
+    let goal = c.facts(&task.goal, "goal");
+    let planned = !task.init.is_empty() || !task.goal.is_empty();
+    if planned {
+        if task.init.is_empty() {
+            c.error(task.goal[0].span, "a task with a `goal { .. }` also needs `init { .. }`");
+        }
+        if task.goal.is_empty() {
+            c.error(task.init[0].span, "a task with `init { .. }` also needs a `goal { .. }`");
+        }
+        c.strips(task, &init);
+    }
+    c.errors.sort_by_key(|d| (d.span.start, d.span.end));
+    if !c.errors.is_empty() {
+        return Err(c.errors);
+    }
+    Ok(Task {
+        name: task.name.text.clone(),
+        robot: robot.unwrap_or_default(),
+        start,
+        scene,
+        settings: settings.unwrap_or_default(),
+        init: planned.then_some(init),
+        goal: planned.then_some(goal),
+        actions,
+    })
+}
