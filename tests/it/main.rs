@@ -4,5 +4,6 @@ mod common;
 mod errors;
 mod ik;
 mod jacobians;
+mod language;
 mod robots;
 mod swivel;
