@@ -131,13 +131,58 @@ pub fn ik_hat_with(
     })
 }
 
-/// Subproblem 1: the angle about unit `w` (through the origin) taking `u` towards `v`.
-fn rotation_angle(w: &Vector3, u: &Vector3, v: &Vector3) -> Option<Real> {
+/// An angle with its sine and cosine, so that rotating by it needs no
+/// further trigonometry.
+#[derive(Clone, Copy)]
+struct Turn {
+    angle: Real,
+    sin: Real,
+    cos: Real,
+}
+
+impl Turn {
+    fn of(angle: Real) -> Self {
+        let (sin, cos) = angle.sin_cos();
+        Self { angle, sin, cos }
+    }
+
+    /// `Rot(axis, ±angle) v` by Rodrigues' formula.
+    fn apply(&self, axis: &Vector3, v: &Vector3, inverse: bool) -> Vector3 {
+        let sin = if inverse { -self.sin } else { self.sin };
+        v * self.cos + axis.cross(v) * sin + axis * (axis.dot(v) * (1.0 - self.cos))
+    }
+}
+
+/// Subproblem 1: the turn about unit `w` (through the origin) taking `u`
+/// towards `v`; `None` when either lies on the axis.
+fn rotation_turn(w: &Vector3, u: &Vector3, v: &Vector3) -> Option<Turn> {
     let (up, vp) = (reject(u, w), reject(v, w));
-    if up.norm() < 1e-12 || vp.norm() < 1e-12 {
+    let (s, c) = (w.dot(&up.cross(&vp)), up.dot(&vp));
+    let h = s.hypot(c);
+    if up.norm_squared() < 1e-24 || vp.norm_squared() < 1e-24 || h == 0.0 {
         return None;
     }
-    Some(w.dot(&up.cross(&vp)).atan2(up.dot(&vp)))
+    Some(Turn { angle: s.atan2(c), sin: s / h, cos: c / h })
+}
+
+/// At most two solutions of a three-axis decomposition.
+#[derive(Clone, Copy)]
+pub(crate) struct Solutions {
+    items: [[Real; 3]; 2],
+    len: usize,
+}
+
+impl Solutions {
+    const NONE: Self = Self { items: [[0.0; 3]; 2], len: 0 };
+
+    pub(crate) fn as_slice(&self) -> &[[Real; 3]] {
+        &self.items[..self.len]
+    }
+
+    fn push(&mut self, s: [Real; 3]) {
+        self.items[self.len] = s;
+        self.len += 1;
+    }
 }
 
 /// Every (a, b, c) with `R = Rot(wa, a) Rot(wb, b) Rot(wc, c)`; where the
@@ -148,7 +193,7 @@ pub(crate) fn decompose(
     wb: &Vector3,
     wc: &Vector3,
     near_a: Real,
-) -> Result<Vec<[Real; 3]>, KinematicsError> {
+) -> Result<Solutions, KinematicsError> {
     // Subproblem 2 on wc: Rot(wb, b) wc = Rot(wa, -a) (R wc) = c.
     let (v, w) = (*wc, r * wc);
     let k = wa.dot(wb);
@@ -160,23 +205,24 @@ pub(crate) fn decompose(
     let beta = (wb.dot(&v) - k * wa.dot(&w)) / (1.0 - k * k);
     let gamma_sq = (v.norm_squared() - alpha * alpha - beta * beta - 2.0 * alpha * beta * k)
         / cross.norm_squared();
+    let mut out = Solutions::NONE;
     if gamma_sq < -1e-9 {
         // The rotation is outside what these three axes can produce.
-        return Ok(Vec::new());
+        return Ok(out);
     }
     let gamma = gamma_sq.max(0.0).sqrt();
     let gammas: &[Real] = if gamma < 1e-12 { &[0.0] } else { &[gamma, -gamma] };
-    let mut out = Vec::with_capacity(2);
+    // Any direction orthogonal to wc shows the last angle.
+    let probe = wc.cross(&if wc.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() });
+    let r_probe = r * probe;
     for &g in gammas {
         let c = alpha * wa + beta * wb + g * cross;
-        let b = rotation_angle(wb, &v, &c).unwrap_or(0.0);
-        let a = rotation_angle(wa, &c, &w).unwrap_or(near_a);
-        let rab = rotation_about(wa, a) * rotation_about(wb, b);
-        let rc = rab.transpose() * r;
-        // Any direction orthogonal to wc shows the last angle.
-        let probe = wc.cross(&if wc.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() });
-        let c_angle = rotation_angle(wc, &probe, &(rc * probe)).unwrap_or(0.0);
-        out.push([a, b, c_angle]);
+        let b = rotation_turn(wb, &v, &c).unwrap_or_else(|| Turn::of(0.0));
+        let a = rotation_turn(wa, &c, &w).unwrap_or_else(|| Turn::of(near_a));
+        // Rot(wc, c) probe = Rot(wb, -b) Rot(wa, -a) R probe.
+        let turned = b.apply(wb, &a.apply(wa, &r_probe, true), true);
+        let c_angle = rotation_turn(wc, &probe, &turned).map_or(0.0, |t| t.angle);
+        out.push([a.angle, b.angle, c_angle]);
     }
     Ok(out)
 }
@@ -270,8 +316,8 @@ fn branches_with_wrist(
             * ow.matrix()
             * s.hand_zero.matrix().transpose();
         let wrists = decompose(&r567, &w[4], &w[5], &w[6], near[4])?;
-        for [q1, q2, q3] in decompose(&r123, &w[0], &w[1], &w[2], near[0])? {
-            for [q5, q6, q7] in &wrists {
+        for &[q1, q2, q3] in decompose(&r123, &w[0], &w[1], &w[2], near[0])?.as_slice() {
+            for [q5, q6, q7] in wrists.as_slice() {
                 let q = JointVector::from_column_slice(&[q1, q2, q3, q4, *q5, *q6, *q7]);
                 out.push(into_range(robot, q));
             }

@@ -94,7 +94,9 @@ impl Group<'_> {
     fn feasible_at(&self, theta: Real, near_a: Real) -> bool {
         let [wa, wb, wc] = self.axes;
         decompose(&self.rotation.at(theta), wa, wb, wc, near_a)
-            .map(|sols| sols.iter().any(|s| (0..3).all(|i| angle_within(self.limits[i], s[i]))))
+            .map(|sols| {
+                sols.as_slice().iter().any(|s| (0..3).all(|i| angle_within(self.limits[i], s[i])))
+            })
             .unwrap_or(false)
     }
 
