@@ -2,10 +2,14 @@
 //! `a2ml._a2ml`. Thin by design: every method converts its inputs, calls
 //! the core and converts the result; all kinematics lives in the core.
 //! Arrays cross as float64 numpy arrays; frames and units as in DESIGN.md §2.
+//! The task language is in [`language`]; exceptions and their mapping here.
 
-use std::path::PathBuf;
+mod language;
+
+use std::path::{Path, PathBuf};
 
 use a2ml_core::kinematics::{self, CpsaState, HatState, KinematicsError};
+use a2ml_core::language::{Diagnostics, LanguageError};
 use a2ml_core::math::{DOF, JointVector, Matrix3, Real, Rotation3, Vector3};
 use a2ml_core::robot::{RobotError, RobotOptions};
 use numpy::ndarray::Array2;
@@ -13,7 +17,7 @@ use numpy::{
     AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLikeDyn, PyUntypedArrayMethods,
 };
 use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyTypeError, PyValueError};
+use pyo3::exceptions::{PyException, PyOSError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple, PyType};
 
@@ -29,6 +33,12 @@ create_exception!(
     UnreachableError,
     A2mlError,
     "The wrist target is outside the reachable annulus."
+);
+create_exception!(
+    a2ml,
+    ParseError,
+    A2mlError,
+    "The text is not a valid A2ML task; `line`, `column`, `message` locate the first problem, `errors` lists all."
 );
 create_exception!(a2ml, JointLimitError, A2mlError, "Every IK solution leaves the joint limits.");
 create_exception!(a2ml, SingularityError, A2mlError, "The configuration or target is singular.");
@@ -55,12 +65,26 @@ impl From<KinematicsError> for CoreError {
     }
 }
 
+impl From<LanguageError> for CoreError {
+    fn from(e: LanguageError) -> Self {
+        Self(e.into())
+    }
+}
+
+impl From<Diagnostics> for CoreError {
+    fn from(d: Diagnostics) -> Self {
+        LanguageError::Invalid(d).into()
+    }
+}
+
 impl From<CoreError> for PyErr {
     fn from(CoreError(e): CoreError) -> Self {
         use a2ml_core::Error;
         let message = e.to_string();
         match e {
             Error::Robot(_) => UrdfError::new_err(message),
+            Error::Language(LanguageError::Invalid(d)) => Python::attach(|py| parse_error(py, &d)),
+            Error::Language(LanguageError::Io { .. }) => PyOSError::new_err(message),
             Error::Kinematics(k) => match k {
                 KinematicsError::Unreachable { .. } => UnreachableError::new_err(message),
                 KinematicsError::JointOutOfLimits { .. } => JointLimitError::new_err(message),
@@ -72,6 +96,51 @@ impl From<CoreError> for PyErr {
             },
         }
     }
+}
+
+/// A `ParseError` whose str is every diagnostic rendered, with the first
+/// one's `line`, `column` (1-based) and `message`, `errors` as
+/// `(line, column, message)` for all, and `path` (the file or None).
+fn parse_error(py: Python<'_>, d: &Diagnostics) -> PyErr {
+    let errors: Vec<(usize, usize, String)> = d
+        .items
+        .iter()
+        .map(|item| {
+            let (line, column) = d.line_col(item.span.start);
+            (line, column, item.message.clone())
+        })
+        .collect();
+    // The core never reports an empty list; if it did, point at the start.
+    let (line, column, message) =
+        errors.first().cloned().unwrap_or_else(|| (1, 1, d.to_string()));
+    let err = ParseError::new_err(d.to_string());
+    let value = err.value(py);
+    let set = || -> PyResult<()> {
+        value.setattr("line", line)?;
+        value.setattr("column", column)?;
+        value.setattr("message", message)?;
+        value.setattr("errors", errors)?;
+        value.setattr("path", d.path.as_deref())
+    };
+    match set() {
+        Ok(()) => err,
+        Err(e) => e,
+    }
+}
+
+/// An I/O error as Python raises it: `OSError(errno, strerror, filename)`,
+/// which Python turns into `FileNotFoundError`, `PermissionError`, ...
+fn os_error(py: Python<'_>, e: &std::io::Error, path: &Path) -> PyErr {
+    let filename = path.to_string_lossy().into_owned();
+    let Some(errno) = e.raw_os_error() else {
+        return PyOSError::new_err(format!("cannot read {filename}: {e}"));
+    };
+    let strerror = py
+        .import("os")
+        .and_then(|os| os.call_method1("strerror", (errno,)))
+        .and_then(|s| s.extract::<String>())
+        .unwrap_or_else(|_| e.to_string());
+    PyOSError::new_err((errno, strerror, filename))
 }
 
 /// A float64 numpy vector.
@@ -451,8 +520,12 @@ fn _a2ml(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<PyRobot>()?;
+    m.add_class::<language::PyTask>()?;
+    m.add_function(wrap_pyfunction!(language::parse, m)?)?;
+    m.add_function(wrap_pyfunction!(language::load, m)?)?;
     m.add("A2mlError", py.get_type::<A2mlError>())?;
     m.add("UrdfError", py.get_type::<UrdfError>())?;
+    m.add("ParseError", py.get_type::<ParseError>())?;
     m.add("UnreachableError", py.get_type::<UnreachableError>())?;
     m.add("JointLimitError", py.get_type::<JointLimitError>())?;
     m.add("SingularityError", py.get_type::<SingularityError>())?;

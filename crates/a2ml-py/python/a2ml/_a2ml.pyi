@@ -7,10 +7,15 @@ are those of the URDF base link (z up). Array arguments accept any array-like
 of the stated shape and are converted to float64; a wrong shape or a NaN or
 infinite entry raises ``ValueError``. Rotation matrices must be orthonormal to
 1e-6 with determinant +1, else ``ValueError``.
+
+A task (:func:`parse`, :func:`load`) comes back as plain Python data in SI
+units: state variables are spelled as :class:`Robot` names them (``"pw"``,
+``"ow"``, ``"swivel"``, ``"os"``, ``"elbow"``), positions are arrays of shape
+(3,), rotations (3, 3), angles floats.
 """
 
 import os
-from typing import Any, final
+from typing import Any, ClassVar, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -18,8 +23,12 @@ from numpy.typing import ArrayLike, NDArray
 __all__ = [
     "__version__",
     "Robot",
+    "Task",
+    "parse",
+    "load",
     "A2mlError",
     "UrdfError",
+    "ParseError",
     "UnreachableError",
     "JointLimitError",
     "SingularityError",
@@ -33,6 +42,25 @@ class A2mlError(Exception):
 
 class UrdfError(A2mlError):
     """The URDF is missing, unreadable, invalid, or holds no 7-revolute-joint arm."""
+
+class ParseError(A2mlError):
+    """The text is not a valid A2ML task.
+
+    ``str(e)`` renders every problem with its location, the source line and a
+    caret, as the command line does. The attributes locate the first problem;
+    ``errors`` lists them all, in source order.
+    """
+
+    line: int
+    """Line of the first problem, 1-based."""
+    column: int
+    """Column of the first problem, 1-based, in characters."""
+    message: str
+    """What is wrong at the first problem, without location."""
+    errors: list[tuple[int, int, str]]
+    """``(line, column, message)`` of every problem."""
+    path: str | None
+    """The file, or None for text parsed without a path."""
 
 class UnreachableError(A2mlError):
     """The wrist target is outside the reachable annulus ``|lu - lf| <= |pw| <= lu + lf``."""
@@ -213,3 +241,110 @@ class Robot:
             ConvergenceError: the arm has no closed-form IK.
             UnreachableError, SingularityError: as :meth:`ik_cpsa`.
         """
+
+@final
+class Task:
+    """A validated A2ML task, immutable; create one with :func:`parse` or
+    :func:`load`.
+
+    Every property builds fresh Python data (arrays included), so changing it
+    does not change the task. A task keeps its source text and path and
+    pickles as ``parse(source, path)``. Tasks compare equal when they say the
+    same thing, whatever their layout and comments.
+    """
+
+    __hash__: ClassVar[None]  # type: ignore[assignment]
+
+    def __reduce__(self) -> tuple[Any, tuple[str, str | None]]:
+        """Pickle as ``parse(source, path)``."""
+
+    def __eq__(self, value: object, /) -> bool:
+        """Equal when both say the same thing; layout and comments aside."""
+
+    @property
+    def name(self) -> str:
+        """The task's name."""
+
+    @property
+    def robot(self) -> str:
+        """The robot URDF path, resolved relative to the task file (or the
+        working directory when parsed without a path)."""
+
+    @property
+    def start(self) -> dict[str, Any] | None:
+        """None, ``{"joints": q}`` with ``q`` of shape (7,) (rad), or
+        ``{"state": {variable: value}}`` with a complete state of one space."""
+
+    @property
+    def scene(self) -> list[dict[str, Any]]:
+        """The obstacles, each a dict with ``"name"``, ``"shape"`` and the
+        shape's fields: ``box`` (``center``, ``size``: full edge lengths),
+        ``sphere`` (``center``, ``radius``), ``capsule`` (``a``, ``b``,
+        ``radius``), ``cylinder`` (``center``, ``radius``, ``height``);
+        points are arrays of shape (3,), lengths floats (m)."""
+
+    @property
+    def settings(self) -> dict[str, Any]:
+        """``rate`` (Hz), ``solver`` (``"auto"``, ``"qp"``, ``"rrt"``, ...),
+        ``seed`` (int), ``transition`` (fraction of the shorter segment) and
+        ``frame`` (``"base"`` or ``"root"``), defaults filled in."""
+
+    @property
+    def init(self) -> list[str] | None:
+        """STRIPS initial facts, or None when the actions run in written order."""
+
+    @property
+    def goal(self) -> list[str] | None:
+        """STRIPS goal facts, or None."""
+
+    @property
+    def actions(self) -> list[dict[str, Any]]:
+        """The actions in written order. Each dict has ``name``,
+        ``description`` (str or None), ``pre``, ``add``, ``del`` (lists of
+        facts), ``solver`` (str or None) and ``kind``:
+
+        - ``"constraints"``: ``goal`` (None or ``{"primary": {variable:
+          value}, "secondary": {variable: value} | None}``), ``path`` (None or
+          ``{"items": [{"variables": [...], "feature": feature}], "space":
+          "cpsa" | "hat" | None, "hard": bool}``) and ``duration`` (s or None);
+        - ``"explicit"``: ``segments``, each ``{"space": "cpsa" | "hat",
+          "duration": float | None, "primitives": [...]}``; a primitive is
+          ``{"variables": [...], "kind": "goal" | "path" | "hold"}`` plus
+          ``goal`` (``{variable: value}``) or ``feature``.
+
+        A feature is ``{"kind": "line", "direction": (3,), "length": float |
+        None}``, ``{"kind": "about", "axis": (3,) array or body axis ("r",
+        "-l", "f", "p", ...), "angle": float | None}``, ``{"kind": "by",
+        "angle": float}`` or ``{"kind": "hold"}``."""
+
+    @property
+    def source(self) -> str:
+        """The text the task was parsed from."""
+
+    @property
+    def path(self) -> str | None:
+        """The file the task was read from or named with, or None."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """``name``, ``robot``, ``start``, ``scene``, ``settings``, ``init``,
+        ``goal`` and ``actions`` in one dict."""
+
+def parse(text: str, path: str | os.PathLike[str] | None = None) -> Task:
+    """Parse and validate an A2ML task.
+
+    ``path`` names the file in messages and anchors a relative robot path;
+    without it the robot path is taken relative to the working directory.
+    Releases the GIL.
+
+    Raises:
+        ParseError: the text is not a valid task (every problem is listed).
+    """
+
+def load(path: str | os.PathLike[str]) -> Task:
+    """Read, parse and validate an A2ML task file; a relative robot path is
+    taken relative to the file's folder. Releases the GIL.
+
+    Raises:
+        FileNotFoundError, PermissionError, OSError: the file cannot be read.
+        ParseError: the text is not a valid task.
+    """
