@@ -49,7 +49,7 @@ mod malformed {
 malformed!(bad_token, 4, 31, "expected");
 malformed!(missing_brace, 6, 1, "expected `+Se` or `action`");
 malformed!(unterminated_string, 1, 7, "expected");
-malformed!(missing_equals, 4, 13, "expected");
+malformed!(missing_equals, 4, 13, "expected `=` or a state variable");
 malformed!(empty_vector, 4, 16, "expected a number");
 malformed!(bad_number, 4, 18, "expected");
 malformed!(no_actions, 3, 1, "expected `action`");

@@ -3,6 +3,8 @@
 
 use clap::{Parser, Subcommand};
 
+use crate::commands::check::CheckArgs;
+use crate::commands::fmt::FmtArgs;
 use crate::commands::robot::RobotArgs;
 
 /// Plans human-like motions for 7-DoF anthropomorphic arms from A2ML tasks.
@@ -13,6 +15,8 @@ Examples:
   a2ml robot robots/iiwa14.urdf
   a2ml robot robots/iiwa14.urdf --at 0.3,0.5,-0.2,1.2,0.4,-0.6,0.1
   a2ml robot robots/panda.urdf --at 0,-45,0,-135,0,90,45 --deg --json
+  a2ml check examples/*.a2ml
+  a2ml fmt --write task.a2ml
 
 Exit codes: 0 success, 1 I/O error, 2 invalid input.")]
 pub struct Cli {
@@ -26,4 +30,8 @@ pub struct Cli {
 pub enum Commands {
     /// Show what a2ml reads from a URDF, and the arm's state at a configuration.
     Robot(RobotArgs),
+    /// Check task files: parse and validate each, report every problem.
+    Check(CheckArgs),
+    /// Print a task file in canonical form, check that it is, or rewrite it.
+    Fmt(FmtArgs),
 }

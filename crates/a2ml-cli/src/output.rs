@@ -1,6 +1,6 @@
 //! Helpers the commands share for presenting results: conversions to plain
 //! arrays for JSON, number formatting and aligned plain-text tables, and
-//! writing to stdout.
+//! writing to stdout and stderr.
 //!
 //! Vectors are `[x, y, z]`, quaternions `[w, x, y, z]` with w ≥ 0.
 
@@ -211,6 +211,16 @@ pub fn print(text: &str) -> Result<(), CliError> {
         }
         _ => Ok(()),
     }
+}
+
+/// `n noun` or `n nouns`.
+pub fn count(n: usize, noun: &str) -> String {
+    if n == 1 { format!("1 {noun}") } else { format!("{n} {noun}s") }
+}
+
+/// Writes a report (e.g. rendered diagnostics) and a line break to stderr.
+pub fn report(text: &str) {
+    let _ = writeln!(std::io::stderr(), "{text}");
 }
 
 /// Writes `warning: <message>` to stderr.

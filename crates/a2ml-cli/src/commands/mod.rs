@@ -1,6 +1,8 @@
 //! One module per subcommand, each with its clap arguments and a `run`
 //! that calls the core and prints the result. [`run`] dispatches.
 
+pub mod check;
+pub mod fmt;
 pub mod robot;
 
 use crate::args::{Cli, Commands};
@@ -13,5 +15,7 @@ use crate::error::CliError;
 pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Commands::Robot(args) => robot::run(&args),
+        Commands::Check(args) => check::run(&args),
+        Commands::Fmt(args) => fmt::run(&args),
     }
 }

@@ -1,30 +1,14 @@
-//! End-to-end tests of the `a2ml` binary: output, JSON keys and exit codes.
+//! `a2ml robot`: output, JSON keys and exit codes.
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
 use serde_json::Value;
+
+use crate::{a2ml, robot_path, stderr, stdout};
 
 /// A regular iiwa14 configuration within the limits whose feasible swivel
 /// angles form proper intervals (not the whole circle).
 const REGULAR: &str = "0.5,-1.8,0.2,-2.0,1.2,1.7,-2";
-
-fn robot_path(name: &str) -> String {
-    let path: PathBuf = [env!("CARGO_MANIFEST_DIR"), "..", "..", "robots", name].iter().collect();
-    path.to_string_lossy().into_owned()
-}
-
-fn a2ml(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_a2ml")).args(args).output().expect("the binary runs")
-}
-
-fn stdout(output: &Output) -> String {
-    String::from_utf8(output.stdout.clone()).expect("UTF-8 stdout")
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8(output.stderr.clone()).expect("UTF-8 stderr")
-}
 
 /// Runs `a2ml robot <urdf> <args> --json`, checks exit 0 and parses stdout.
 fn robot_json(urdf: &str, args: &[&str]) -> Value {

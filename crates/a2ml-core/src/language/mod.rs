@@ -2,11 +2,13 @@
 //! [`Task`], with located diagnostics.
 //!
 //! Entry points: [`parse`] (text), [`load`] (a file), [`parse_ast`] (the
-//! syntax tree alone). Units become SI at
+//! syntax tree alone), [`format()`] (a syntax tree back to canonical text;
+//! comments are not in the tree and are dropped). Units become SI at
 //! validation; every syntax node keeps the byte span of its text.
 
 pub mod ast;
 mod diagnostic;
+mod format;
 mod syntax;
 mod task;
 mod validate;
@@ -14,6 +16,7 @@ mod validate;
 use std::path::Path;
 
 pub use diagnostic::{Diagnostic, Diagnostics};
+pub use format::format;
 pub use task::*;
 
 /// Why a task file could not be read.

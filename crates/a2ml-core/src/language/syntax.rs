@@ -62,6 +62,7 @@ fn describe(rule: &Rule) -> String {
         explicit_body => "`explicit { segment ... }`",
         goal => "`goal`",
         goal_term => "`variables = values`",
+        equals => "`=`",
         priority => "`>`",
         path => "`path`",
         path_item => "`variables feature`",
@@ -378,7 +379,7 @@ fn goal(node: Node<'_>) -> ast::Goal {
             let tsp = span(&term);
             let mut inner = term.into_inner();
             let vars = inner.next().map(variables).unwrap_or_default();
-            let vals = inner.next().map(values).unwrap_or_default();
+            let vals = inner.find(|n| n.as_rule() == Rule::values).map(values).unwrap_or_default();
             ast::GoalTerm { variables: vars, values: vals, span: tsp }
         })
         .collect();

@@ -1,0 +1,184 @@
+//! `a2ml check` and `a2ml fmt` on the task files of `tests/fixtures`.
+
+use std::fs;
+use std::path::PathBuf;
+
+use crate::{a2ml, stderr, stdout};
+
+/// A fixture's path, as the binary is given it.
+fn fixture(name: &str) -> String {
+    let path: PathBuf = [env!("CARGO_MANIFEST_DIR"), "tests", "fixtures", name].iter().collect();
+    path.to_string_lossy().into_owned()
+}
+
+/// A fresh, empty folder for one test's files.
+fn scratch(test: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("language").join(test);
+    let _ = fs::remove_dir_all(&dir);
+    fs::create_dir_all(&dir).expect("scratch folder");
+    dir
+}
+
+fn read(path: &str) -> String {
+    fs::read_to_string(path).expect("readable file")
+}
+
+#[test]
+fn check_valid_file() {
+    let valid = fixture("valid.a2ml");
+    let output = a2ml(&["check", &valid]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+    assert_eq!(stdout(&output), format!("{valid}: ok (task push_box_a_aside, 4 actions)\n"));
+    assert!(stderr(&output).is_empty());
+}
+
+#[test]
+fn check_invalid_file_shows_every_problem_located() {
+    let invalid = fixture("invalid.a2ml");
+    let output = a2ml(&["check", &invalid]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(stdout(&output).is_empty());
+    let err = stderr(&output);
+    assert!(err.contains(&format!("--> {invalid}:3:12\n")), "{err}");
+    assert!(err.contains("3 | settings { rat 100 Hz }\n  |            ^^^\n"), "{err}");
+    assert!(err.contains("did you mean `rate`?"), "{err}");
+    assert!(err.contains(&format!("--> {invalid}:6:10\n")), "several problems: {err}");
+    assert!(err.ends_with("error: 1 of 1 file failed the check: 1 invalid\n"), "{err}");
+}
+
+#[test]
+fn check_syntax_error() {
+    let output = a2ml(&["check", &fixture("syntax_error.a2ml")]);
+    assert_eq!(output.status.code(), Some(2));
+    let err = stderr(&output);
+    assert!(err.contains("syntax_error.a2ml:4:15"), "{err}");
+    assert!(err.contains("\n  |               ^\n"), "{err}");
+}
+
+#[test]
+fn check_missing_file_exits_1() {
+    let output = a2ml(&["check", "no/such/task.a2ml"]);
+    assert_eq!(output.status.code(), Some(1));
+    let err = stderr(&output);
+    assert!(err.starts_with("error: cannot read no/such/task.a2ml: "), "{err}");
+}
+
+#[test]
+fn check_reports_every_file() {
+    let (valid, invalid) = (fixture("valid.a2ml"), fixture("invalid.a2ml"));
+    let output = a2ml(&["check", &invalid, &valid]);
+    assert_eq!(output.status.code(), Some(2));
+    assert_eq!(stdout(&output), format!("{valid}: ok (task push_box_a_aside, 4 actions)\n"));
+    let err = stderr(&output);
+    assert!(err.contains(&format!("{invalid}:3:12")), "{err}");
+    assert!(err.ends_with("error: 1 of 2 files failed the check: 1 invalid\n"), "{err}");
+
+    // An unreadable file outweighs an invalid one.
+    let output = a2ml(&["check", &invalid, "missing.a2ml", &valid]);
+    assert_eq!(output.status.code(), Some(1));
+    let err = stderr(&output);
+    assert!(err.contains(&format!("{invalid}:3:12")), "{err}");
+    assert!(err.contains("error: cannot read missing.a2ml"), "{err}");
+    assert!(err.ends_with("error: 2 of 3 files failed the check: 1 unreadable, 1 invalid\n"));
+    assert!(stdout(&output).contains("valid.a2ml: ok"));
+}
+
+#[test]
+fn fmt_prints_the_canonical_form() {
+    let output = a2ml(&["fmt", &fixture("valid.a2ml")]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+    assert_eq!(stdout(&output), read(&fixture("canonical.a2ml")));
+    assert!(stderr(&output).contains("comments are not kept"), "{}", stderr(&output));
+}
+
+#[test]
+fn fmt_is_idempotent_and_keeps_the_task() {
+    let canonical = fixture("canonical.a2ml");
+    let output = a2ml(&["fmt", &canonical]);
+    assert_eq!(output.status.code(), Some(0));
+    assert_eq!(stdout(&output), read(&canonical));
+    assert!(stderr(&output).is_empty(), "no comments, no warning");
+
+    let output = a2ml(&["check", &canonical]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+    assert!(stdout(&output).ends_with(": ok (task push_box_a_aside, 4 actions)\n"));
+}
+
+#[test]
+fn fmt_check() {
+    let output = a2ml(&["fmt", "--check", &fixture("canonical.a2ml")]);
+    assert_eq!(output.status.code(), Some(0));
+    assert!(stdout(&output).is_empty() && stderr(&output).is_empty());
+
+    let valid = fixture("valid.a2ml");
+    let output = a2ml(&["fmt", "--check", &fixture("canonical.a2ml"), &valid]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(stdout(&output).is_empty());
+    let err = stderr(&output);
+    assert!(err.contains(&format!("error: {valid}: not in canonical form")), "{err}");
+    assert!(err.ends_with("error: 1 of 2 files failed the check: 1 not canonical\n"), "{err}");
+}
+
+#[test]
+fn fmt_write_rewrites_in_place() {
+    let dir = scratch("fmt_write");
+    let path = dir.join("task.a2ml");
+    fs::copy(fixture("valid.a2ml"), &path).expect("copy");
+    let path = path.to_string_lossy().into_owned();
+    let output = a2ml(&["fmt", "--write", &path]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+    assert!(stdout(&output).is_empty());
+    assert_eq!(read(&path), read(&fixture("canonical.a2ml")));
+    let left: Vec<_> = fs::read_dir(&dir).expect("folder").collect();
+    assert_eq!(left.len(), 1, "no temporary file left behind");
+
+    let output = a2ml(&["fmt", "--check", &path]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+}
+
+#[test]
+fn fmt_needs_only_valid_syntax() {
+    let output = a2ml(&["fmt", &fixture("invalid.a2ml")]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+    assert!(stdout(&output).contains("goal θs = 30 degs\n"));
+
+    let output = a2ml(&["fmt", &fixture("syntax_error.a2ml")]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(stdout(&output).is_empty());
+    let err = stderr(&output);
+    assert!(err.contains("syntax_error.a2ml:4:15") && err.contains("  |               ^\n"));
+}
+
+#[test]
+fn fmt_exit_codes() {
+    let output = a2ml(&["fmt", "no/such/task.a2ml"]);
+    assert_eq!(output.status.code(), Some(1));
+    assert!(stderr(&output).starts_with("error: cannot read no/such/task.a2ml: "));
+
+    let canonical = fixture("canonical.a2ml");
+    let output = a2ml(&["fmt", &canonical, &canonical]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(stderr(&output).contains("--check or --write"));
+
+    let output = a2ml(&["fmt", "--check", "--write", &canonical]);
+    assert_eq!(output.status.code(), Some(2));
+}
+
+#[cfg(unix)]
+#[test]
+fn fmt_write_through_a_link_keeps_the_link_and_permissions() {
+    use std::os::unix::fs::{PermissionsExt, symlink};
+
+    let dir = scratch("fmt_write_link");
+    let target = dir.join("real.a2ml");
+    fs::copy(fixture("valid.a2ml"), &target).expect("copy");
+    fs::set_permissions(&target, fs::Permissions::from_mode(0o640)).expect("chmod");
+    let link = dir.join("link.a2ml");
+    symlink(&target, &link).expect("symlink");
+    let output = a2ml(&["fmt", "--write", &link.to_string_lossy()]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+    assert!(fs::symlink_metadata(&link).expect("link").file_type().is_symlink());
+    assert_eq!(read(&target.to_string_lossy()), read(&fixture("canonical.a2ml")));
+    let mode = fs::metadata(&target).expect("target").permissions().mode();
+    assert_eq!(mode & 0o777, 0o640);
+}

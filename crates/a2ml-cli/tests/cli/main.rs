@@ -1,0 +1,27 @@
+//! End-to-end tests of the `a2ml` binary, one module per area: output,
+//! files written and exit codes.
+
+mod language;
+mod robot;
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+/// A file of the repository's `robots/`.
+fn robot_path(name: &str) -> String {
+    let path: PathBuf = [env!("CARGO_MANIFEST_DIR"), "..", "..", "robots", name].iter().collect();
+    path.to_string_lossy().into_owned()
+}
+
+/// Runs the binary.
+fn a2ml(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_a2ml")).args(args).output().expect("the binary runs")
+}
+
+fn stdout(output: &Output) -> String {
+    String::from_utf8(output.stdout.clone()).expect("UTF-8 stdout")
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8(output.stderr.clone()).expect("UTF-8 stderr")
+}
