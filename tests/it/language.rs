@@ -26,10 +26,7 @@ fn expect_error(name: &str, line: usize, column: usize, message: &str) {
         d.line_col(item.span.start) == (line, column) && item.message.contains(message)
     });
     let rendered = d.to_string();
-    assert!(
-        found,
-        "{name}: no error at {line}:{column} containing {message:?}; got:\n{rendered}"
-    );
+    assert!(found, "{name}: no error at {line}:{column} containing {message:?}; got:\n{rendered}");
     assert!(rendered.contains(&format!("{name}.a2ml:{line}:{column}")), "{rendered}");
     assert!(rendered.contains('^'), "{rendered}");
 }
@@ -46,64 +43,65 @@ macro_rules! malformed {
 mod malformed {
     use super::expect_error;
 
-malformed!(bad_token, 4, 31, "expected");
-malformed!(missing_brace, 6, 1, "expected `+Se` or `action`");
-malformed!(unterminated_string, 1, 7, "expected");
-malformed!(missing_equals, 4, 13, "expected `=` or a state variable");
-malformed!(empty_vector, 4, 16, "expected a number");
-malformed!(bad_number, 4, 18, "expected");
-malformed!(no_actions, 3, 1, "expected `action`");
-malformed!(unknown_top_level, 2, 1, "expected");
-malformed!(priority_without_goal, 5, 3, "expected");
-malformed!(bad_path_hardness_colon, 5, 3, "expected");
-malformed!(unknown_variable, 4, 10, "unknown state variable `θs`");
-malformed!(unknown_variable_ascii, 4, 10, "unknown state variable `Pv`");
-malformed!(unknown_unit, 4, 18, "unknown unit `degs`");
-malformed!(wrong_dimension, 4, 18, "`cm` is a length");
-malformed!(position_in_degrees, 4, 31, "`deg` is an angle");
-malformed!(unknown_axis, 4, 19, "unknown axis `w`");
-malformed!(unknown_shape, 3, 7, "unknown shape `sphre`");
-malformed!(unknown_setting, 2, 12, "unknown setting `rat`");
-malformed!(unknown_solver, 5, 12, "unknown solver `rrtt`");
-malformed!(unknown_hardness, 4, 36, "expected `hard` or `soft`");
-malformed!(unknown_frame, 2, 18, "`base` or `root`");
-malformed!(mixed_spaces_goal, 4, 13, "Os belongs to HAT space, but Pw belongs to CPSA space");
-malformed!(mixed_spaces_path, 4, 35, "θe belongs to HAT space");
-malformed!(priority_inside_one_space, 4, 33, "both goals are in CPSA space");
-malformed!(same_variable_both_goals, 4, 30, "Ow appears in both goals");
-malformed!(variable_twice, 4, 13, "Pw is named twice");
-malformed!(value_count, 4, 10, "2 variables (Pw, Ow) but 1 value");
-malformed!(wrong_value_kind, 4, 15, "Ow is a rotation");
-malformed!(vector_length, 4, 15, "Pw needs 3 numbers, but 2 are given");
-malformed!(line_on_angle, 4, 10, "`line` moves Pw, not θsw");
-malformed!(by_on_position, 4, 10, "`by` changes θsw or θe, not Pw");
-malformed!(zero_line_direction, 4, 18, "the line direction must not be zero");
-malformed!(negative_path_size, 4, 28, "the line length must be positive");
-malformed!(zero_by, 4, 17, "`by` needs a non-zero angle");
-malformed!(axes_not_orthogonal, 4, 15, "must be orthogonal, but they are 45.0° apart");
-malformed!(axes_wrong_names, 4, 20, "Os is given by axes `r` and `l`, not `f`");
-malformed!(zero_quaternion, 4, 15, "a quaternion must not be zero");
-malformed!(no_goal_no_path, 3, 10, "has neither a goal nor a path");
-malformed!(two_goals, 5, 5, "an action has one `goal`");
-malformed!(negative_duration, 5, 14, "the duration must be positive");
-malformed!(incomplete_segment, 4, 5, "does not drive θsw");
-malformed!(mixed_segment, 4, 31, "θe belongs to HAT space, but Pw belongs to CPSA space");
-malformed!(repeated_in_segment, 4, 40, "θsw is already driven in this segment");
-malformed!(remove_absent, 4, 36, "θsw is not driven here");
-malformed!(bare_primitive, 4, 19, "a primitive needs `.goal(..)`");
-malformed!(ow_only_segment, 4, 5, "a segment covers a whole space");
-malformed!(duplicate_obstacle, 4, 3, "obstacle `post` is declared twice");
-malformed!(negative_radius, 3, 37, "the radius must be positive");
-malformed!(start_wrong_count, 2, 7, "the start configuration needs 7 numbers, but 3 are given");
-malformed!(start_state_incomplete, 2, 7, "also needs Ow");
-malformed!(missing_robot_file, 1, 8, "robot file not found");
-malformed!(no_robot, 1, 1, "the file names no robot");
+    malformed!(bad_token, 4, 31, "expected");
+    malformed!(missing_brace, 6, 1, "expected `+Se` or `action`");
+    malformed!(unterminated_string, 1, 7, "expected");
+    malformed!(missing_equals, 4, 13, "expected `=` or a state variable");
+    malformed!(empty_vector, 4, 16, "expected a number");
+    malformed!(bad_number, 4, 18, "expected");
+    malformed!(no_actions, 3, 1, "expected `action`");
+    malformed!(unknown_top_level, 2, 1, "expected");
+    malformed!(priority_without_goal, 5, 3, "expected");
+    malformed!(bad_path_hardness_colon, 5, 3, "expected");
+    malformed!(unknown_variable, 4, 10, "unknown state variable `θs`");
+    malformed!(unknown_variable_ascii, 4, 10, "unknown state variable `Pv`");
+    malformed!(unknown_unit, 4, 18, "unknown unit `degs`");
+    malformed!(wrong_dimension, 4, 18, "`cm` is a length");
+    malformed!(position_in_degrees, 4, 31, "`deg` is an angle");
+    malformed!(unknown_axis, 4, 19, "unknown axis `w`");
+    malformed!(unknown_shape, 3, 7, "unknown shape `sphre`");
+    malformed!(unknown_setting, 2, 12, "unknown setting `rat`");
+    malformed!(unknown_solver, 5, 12, "unknown solver `rrtt`");
+    malformed!(unknown_hardness, 4, 36, "expected `hard` or `soft`");
+    malformed!(unknown_frame, 2, 18, "`base` or `root`");
+    malformed!(mixed_spaces_goal, 4, 13, "Os belongs to HAT space, but Pw belongs to CPSA space");
+    malformed!(mixed_spaces_path, 4, 35, "θe belongs to HAT space");
+    malformed!(priority_inside_one_space, 4, 33, "both goals are in CPSA space");
+    malformed!(same_variable_both_goals, 4, 30, "Ow appears in both goals");
+    malformed!(variable_twice, 4, 13, "Pw is named twice");
+    malformed!(value_count, 4, 10, "2 variables (Pw, Ow) but 1 value");
+    malformed!(wrong_value_kind, 4, 15, "Ow is a rotation");
+    malformed!(vector_length, 4, 15, "Pw needs 3 numbers, but 2 are given");
+    malformed!(line_on_angle, 4, 10, "`line` moves Pw, not θsw");
+    malformed!(by_on_position, 4, 10, "`by` changes θsw or θe, not Pw");
+    malformed!(zero_line_direction, 4, 18, "the line direction must not be zero");
+    malformed!(negative_path_size, 4, 28, "the line length must be positive");
+    malformed!(zero_by, 4, 17, "`by` needs a non-zero angle");
+    malformed!(axes_not_orthogonal, 4, 15, "must be orthogonal, but they are 45.0° apart");
+    malformed!(axes_wrong_names, 4, 20, "Os is given by axes `r` and `l`, not `f`");
+    malformed!(zero_quaternion, 4, 15, "a quaternion must not be zero");
+    malformed!(no_goal_no_path, 3, 10, "has neither a goal nor a path");
+    malformed!(two_goals, 5, 5, "an action has one `goal`");
+    malformed!(negative_duration, 5, 14, "the duration must be positive");
+    malformed!(incomplete_segment, 4, 5, "does not drive θsw");
+    malformed!(mixed_segment, 4, 31, "θe belongs to HAT space, but Pw belongs to CPSA space");
+    malformed!(repeated_in_segment, 4, 40, "θsw is already driven in this segment");
+    malformed!(remove_absent, 4, 36, "θsw is not driven here");
+    malformed!(bare_primitive, 4, 19, "a primitive needs `.goal(..)`");
+    malformed!(ow_only_segment, 4, 5, "a segment covers a whole space");
+    malformed!(duplicate_obstacle, 4, 3, "obstacle `post` is declared twice");
+    malformed!(negative_radius, 3, 37, "the radius must be positive");
+    malformed!(start_wrong_count, 2, 7, "the start configuration needs 7 numbers, but 3 are given");
+    malformed!(start_state_incomplete, 2, 7, "also needs Ow");
+    malformed!(missing_robot_file, 1, 8, "robot file not found");
+    malformed!(no_robot, 1, 1, "the file names no robot");
     malformed!(several_errors, 2, 12, "unknown setting `rat`");
-malformed!(duplicate_action, 4, 10, "action `a` is declared twice");
-malformed!(strips_unknown_fact, 6, 11, "fact `holdin` is never true");
-malformed!(strips_goal_unreachable, 4, 10, "fact `box_aside` is never true");
-malformed!(strips_init_without_goal, 3, 8, "also needs a `goal { .. }`");
-malformed!(bad_seed, 2, 17, "the seed is a non-negative whole number");
+    malformed!(unknown_unit_and_variable, 4, 18, "unknown unit `degs`");
+    malformed!(duplicate_action, 4, 10, "action `a` is declared twice");
+    malformed!(strips_unknown_fact, 6, 11, "fact `holdin` is never true");
+    malformed!(strips_goal_unreachable, 4, 10, "fact `box_aside` is never true");
+    malformed!(strips_init_without_goal, 3, 8, "also needs a `goal { .. }`");
+    malformed!(bad_seed, 2, 17, "the seed is a non-negative whole number");
 }
 
 #[test]
@@ -122,6 +120,23 @@ fn several_errors_are_all_reported() {
     let d = diagnostics("several_errors");
     assert!(d.items.len() >= 3, "{d}");
     assert!(d.to_string().ends_with(&format!("{} errors", d.items.len())));
+}
+
+#[test]
+fn independent_problems_of_one_statement_are_all_reported() {
+    let d = diagnostics("unknown_unit_and_variable");
+    let messages: Vec<&str> = d.items.iter().map(|i| i.message.as_str()).collect();
+    for expected in [
+        "unknown state variable `θs`",
+        "unknown unit `degs`",
+        "found `medium`",
+        "Os belongs to HAT",
+    ] {
+        assert!(
+            messages.iter().any(|m| m.contains(expected)),
+            "{expected:?} missing: {messages:?}"
+        );
+    }
 }
 
 #[test]
@@ -150,13 +165,88 @@ mod no_panic {
 
     /// Fragments of real A2ML, so that random sequences reach deep rules.
     const TOKENS: &[&str] = &[
-        "robot", "\"../../robots/coman_right_arm.urdf\"", "start", "scene", "settings", "task",
-        "action", "explicit", "segment", "goal", "path", "duration", "solver", "init", "pre",
-        "add", "del", "hold", "line", "about", "by", "hard", "soft", "box", "sphere", "capsule",
-        "cylinder", "at", "size", "from", "to", "radius", "height", "rpy", "quat", "axes", "Pw",
-        "Ow", "θsw", "Os", "θe", "sw", "e", "x", "-z", "r", "f", "p", "{", "}", "(", ")", "[",
-        "]", ",", ":", "=", ">", "≻", ".", "+Pa", "-Pa", "+Tr", "+Se", "0", "-1.5", "30", "1e3",
-        "deg", "rad", "m", "cm", "mm", "s", "ms", "%", "Hz", "°", "name", "\n", "#c\n", " ",
+        "robot",
+        "\"../../robots/coman_right_arm.urdf\"",
+        "start",
+        "scene",
+        "settings",
+        "task",
+        "action",
+        "explicit",
+        "segment",
+        "goal",
+        "path",
+        "duration",
+        "solver",
+        "init",
+        "pre",
+        "add",
+        "del",
+        "hold",
+        "line",
+        "about",
+        "by",
+        "hard",
+        "soft",
+        "box",
+        "sphere",
+        "capsule",
+        "cylinder",
+        "at",
+        "size",
+        "from",
+        "to",
+        "radius",
+        "height",
+        "rpy",
+        "quat",
+        "axes",
+        "Pw",
+        "Ow",
+        "θsw",
+        "Os",
+        "θe",
+        "sw",
+        "e",
+        "x",
+        "-z",
+        "r",
+        "f",
+        "p",
+        "{",
+        "}",
+        "(",
+        ")",
+        "[",
+        "]",
+        ",",
+        ":",
+        "=",
+        ">",
+        "≻",
+        ".",
+        "+Pa",
+        "-Pa",
+        "+Tr",
+        "+Se",
+        "0",
+        "-1.5",
+        "30",
+        "1e3",
+        "deg",
+        "rad",
+        "m",
+        "cm",
+        "mm",
+        "s",
+        "ms",
+        "%",
+        "Hz",
+        "°",
+        "name",
+        "\n",
+        "#c\n",
+        " ",
     ];
 
     proptest! {

@@ -351,8 +351,30 @@ impl Checker<'_> {
         out.into_iter().collect()
     }
 
+    /// Checks only that every unit is known (when the variables are not,
+    /// so that their values cannot be typed).
+    fn units_of(&mut self, value: &ast::Value) {
+        let units: Vec<&Option<Name>> = match value {
+            ast::Value::Quantity(q) => vec![&q.unit],
+            ast::Value::Vector(v) => vec![&v.unit],
+            ast::Value::Rpy { unit, .. } => vec![unit],
+            ast::Value::Quat { .. } => vec![],
+            ast::Value::Axes { pairs, .. } => pairs.iter().map(|(_, v)| &v.unit).collect(),
+        };
+        for unit in units.into_iter().flatten() {
+            if !UNITS.iter().any(|(n, ..)| *n == unit.text) {
+                let help = did_you_mean(&unit.text, UNITS.iter().map(|(n, ..)| *n))
+                    .map(|s| format!("did you mean `{s}`?"));
+                self.error_with_help(unit.span, format!("unknown unit `{}`", unit.text), help);
+            }
+        }
+    }
+
     fn goal_term(&mut self, term: &ast::GoalTerm) -> Option<Goal> {
-        let (vars, space) = self.variables(&term.variables)?;
+        let Some((vars, space)) = self.variables(&term.variables) else {
+            term.values.iter().for_each(|v| self.units_of(v));
+            return None;
+        };
         let targets = self.targets(&vars, &term.values, term.span)?;
         Some(Goal { targets: vars.into_iter().zip(targets).collect(), space, span: term.span })
     }
@@ -488,16 +510,23 @@ impl Checker<'_> {
                 None => ok = false,
             }
         }
-        let space = self.space_of(&all_names, &all_vars)?;
         let hard = match &path.hardness {
-            None => true,
-            Some(h) if h.text == "hard" => true,
-            Some(h) if h.text == "soft" => false,
+            None => Some(true),
+            Some(h) if h.text == "hard" => Some(true),
+            Some(h) if h.text == "soft" => Some(false),
             Some(h) => {
-                self.error(h.span, format!("expected `hard` or `soft`, found `{}`", h.text));
-                return None;
+                let help =
+                    did_you_mean(&h.text, ["hard", "soft"]).map(|s| format!("did you mean `{s}`?"));
+                self.error_with_help(
+                    h.span,
+                    format!("expected `hard` or `soft`, found `{}`", h.text),
+                    help,
+                );
+                None
             }
         };
+        let space = if ok { self.space_of(&all_names, &all_vars)? } else { None };
+        let hard = hard?;
         ok.then_some(PathConstraint { items, space, hard, span: path.span })
     }
 
