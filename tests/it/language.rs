@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use a2ml::language::{Diagnostics, parse, parse_ast};
+use a2ml::language::{Diagnostics, format, load, parse, parse_ast};
 
 fn malformed_path(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/malformed").join(format!("{name}.a2ml"))
@@ -113,6 +113,35 @@ fn every_corpus_file_has_a_test() {
         let stem = path.file_stem().and_then(|s| s.to_str()).expect("utf-8 name").to_owned();
         assert!(here.contains(&format!("malformed!({stem},")), "{stem}.a2ml has no test");
     }
+}
+
+/// Every shipped example validates and survives `fmt`: print, parse, and
+/// the same syntax tree comes back; printing again changes nothing.
+#[test]
+fn examples_validate_and_round_trip_through_fmt() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples");
+    let mut count = 0;
+    for entry in std::fs::read_dir(dir).expect("examples folder") {
+        let path = entry.expect("entry").path();
+        if path.extension().and_then(|e| e.to_str()) != Some("a2ml") {
+            continue;
+        }
+        count += 1;
+        if let Err(e) = load(&path) {
+            panic!("{} does not validate:\n{e}", path.display());
+        }
+        let text = std::fs::read_to_string(&path).expect("readable");
+        let tree = parse_ast(&text, Some(&path)).expect("parses");
+        let printed = format(&tree);
+        let again = parse_ast(&printed, Some(&path))
+            .unwrap_or_else(|e| panic!("{}: fmt output does not parse:\n{e}\n{printed}", path.display()));
+        assert_eq!(again, tree, "{}: fmt changed the syntax tree", path.display());
+        assert_eq!(format(&again), printed, "{}: fmt is not idempotent", path.display());
+        // The printed form means the same task.
+        let task = parse(&printed, Some(&path)).expect("printed form validates");
+        assert_eq!(task, load(&path).expect("validates"), "{}", path.display());
+    }
+    assert!(count >= 20, "only {count} examples");
 }
 
 #[test]
