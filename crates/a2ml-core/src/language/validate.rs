@@ -93,8 +93,13 @@ impl Checker<'_> {
                 None
             }
             None => {
-                let help = did_you_mean(&unit.text, UNITS.iter().map(|(n, ..)| *n))
-                    .map(|s| format!("did you mean `{s}`?"));
+                // Prefer a unit of the dimension expected here.
+                let help = did_you_mean(
+                    &unit.text,
+                    UNITS.iter().filter(|(_, d, _)| *d == dimension).map(|(n, ..)| *n),
+                )
+                .or_else(|| did_you_mean(&unit.text, UNITS.iter().map(|(n, ..)| *n)))
+                .map(|s| format!("did you mean `{s}`?"));
                 self.error_with_help(unit.span, format!("unknown unit `{}`", unit.text), help);
                 None
             }
@@ -224,6 +229,32 @@ impl Checker<'_> {
             }
         }
         Some(space.map(|(s, _)| s))
+    }
+
+    /// A segment's space, from its first variable that fixes one; a variable
+    /// of the other space is named against the segment's variables.
+    fn segment_space(&mut self, names: &[Name], vars: &[Variable]) -> Option<Option<Space>> {
+        let mut space: Option<Space> = None;
+        for (n, v) in names.iter().zip(vars) {
+            match (space, v.space()) {
+                (None, s) => space = s,
+                (Some(t), Some(s)) if s != t => {
+                    self.error(
+                        n.span,
+                        format!(
+                            "{} belongs to {} space, but this segment is in {} space ({})",
+                            v.symbol(),
+                            s.name(),
+                            t.name(),
+                            list(&t.variables())
+                        ),
+                    );
+                    return None;
+                }
+                _ => {}
+            }
+        }
+        Some(space)
     }
 
     fn rotation(&mut self, value: &ast::Value, keys: [&str; 2], what: &str) -> Option<Rotation3> {
@@ -530,6 +561,56 @@ impl Checker<'_> {
         ok.then_some(PathConstraint { items, space, hard, span: path.span })
     }
 
+    /// What a path means next to the goal: without one, nothing can size an
+    /// open path or be given way to by a soft one; with one, a variable
+    /// cannot be both held to a hard path and sent to a goal.
+    fn path_against_goal(
+        &mut self,
+        ast_path: &ast::Path,
+        path: &PathConstraint,
+        goal: Option<&GoalConstraint>,
+        no_goal: bool,
+    ) {
+        if no_goal {
+            for (item, ast_item) in path.items.iter().zip(&ast_path.items) {
+                if matches!(
+                    item.feature,
+                    PathFeature::Line { length: None, .. } | PathFeature::About { angle: None, .. }
+                ) {
+                    self.error(
+                        ast_item.span,
+                        "without a goal nothing can compute this path's size: give it (e.g. `0.1 m`, `30 deg`)",
+                    );
+                }
+            }
+            if let (false, Some(h)) = (path.hard, &ast_path.hardness) {
+                self.error(h.span, "a soft path gives way to a goal, but this action has none");
+            }
+        }
+        // A soft path may give way to a goal on the same variable (types V, VII).
+        let Some(goal) = goal.filter(|_| path.hard) else { return };
+        let goal_vars: Vec<Variable> = goal
+            .primary
+            .targets
+            .iter()
+            .chain(goal.secondary.iter().flat_map(|g| &g.targets))
+            .map(|(v, _)| *v)
+            .collect();
+        for (item, ast_item) in path.items.iter().zip(&ast_path.items) {
+            for (v, n) in item.variables.iter().zip(&ast_item.variables) {
+                if goal_vars.contains(v) {
+                    self.error(
+                        n.span,
+                        format!(
+                            "{} has both a goal and a path constraint in this action",
+                            v.symbol()
+                        ),
+                    );
+                }
+            }
+        }
+    }
+
     fn solver(&mut self, name: &Name) -> Option<SolverChoice> {
         let found = SolverChoice::NAMES.iter().find(|(n, _)| *n == name.text).map(|(_, s)| *s);
         if found.is_none() {
@@ -544,77 +625,91 @@ impl Checker<'_> {
         found
     }
 
+    /// A segment's primitives. `-Pa` binds to the group just before it
+    /// (paper eq. 4: MP− = complete primitive −Pa MP), so the complement
+    /// may come first or last; a bare group is allowed right before `-Pa`
+    /// and holds its remaining variables.
     fn segment(&mut self, segment: &ast::Segment) -> Option<Segment> {
-        let mut primitives: Vec<Primitive> = Vec::new();
-        let mut names: Vec<Name> = Vec::new();
-        let mut vars_seen: Vec<Variable> = Vec::new();
+        // (names, variables, constraint) per group, after removals.
+        let mut groups: Vec<(Vec<Name>, Vec<Variable>, Option<PrimitiveConstraint>, bool)> =
+            Vec::new();
         let mut ok = true;
-        for (combine, p) in &segment.primitives {
+        let prims = &segment.primitives;
+        for (k, (combine, p)) in prims.iter().enumerate() {
             let Some((vars, _)) = self.variables(&p.variables) else {
                 ok = false;
                 continue;
             };
+            let next_removes = prims.get(k + 1).is_some_and(|(c, _)| *c == ast::Combine::Remove);
             match (combine, &p.constraint) {
-                (ast::Combine::Add, None) => {
-                    self.error(p.span, "a primitive needs `.goal(..)`, `.path(..)` or `.hold`");
+                (ast::Combine::Add, None) if !next_removes => {
+                    self.error(
+                        p.span,
+                        "a primitive needs `.goal(..)`, `.path(..)` or `.hold` \
+                         (a bare group may only stand before `-Pa`)",
+                    );
                     ok = false;
                 }
+                (ast::Combine::Add, None) => {
+                    groups.push((
+                        p.variables.clone(),
+                        vars,
+                        Some(PrimitiveConstraint::Hold),
+                        false,
+                    ));
+                }
                 (ast::Combine::Add, Some(c)) => {
-                    for (v, n) in vars.iter().zip(&p.variables) {
-                        if vars_seen.contains(v) {
-                            self.error(
-                                n.span,
-                                format!("{} is already driven in this segment", v.symbol()),
-                            );
-                            ok = false;
-                        }
-                    }
                     let constraint = match c {
                         ast::PrimitiveConstraint::Goal(values) => {
                             self.targets(&vars, values, p.span).map(PrimitiveConstraint::Goal)
                         }
                         ast::PrimitiveConstraint::Path(f) => {
-                            self.feature(&vars, &p.variables, f).map(PrimitiveConstraint::Path)
+                            let feature = self.feature(&vars, &p.variables, f);
+                            if let Some(
+                                PathFeature::Line { length: None, .. }
+                                | PathFeature::About { angle: None, .. },
+                            ) = feature
+                            {
+                                self.error(
+                                    p.span,
+                                    "a path in an explicit segment needs its size: nothing computes it here",
+                                );
+                                ok = false;
+                            }
+                            feature.map(PrimitiveConstraint::Path)
                         }
                         ast::PrimitiveConstraint::Hold => Some(PrimitiveConstraint::Hold),
                     };
-                    match constraint {
-                        Some(constraint) => {
-                            vars_seen.extend(&vars);
-                            names.extend(p.variables.iter().cloned());
-                            primitives.push(Primitive { variables: vars, constraint });
-                        }
-                        None => ok = false,
-                    }
+                    ok &= constraint.is_some();
+                    groups.push((p.variables.clone(), vars, constraint, true));
                 }
                 (ast::Combine::Remove, Some(_)) => {
                     self.error(p.span, "`-Pa` removes variables: write them without a constraint");
                     ok = false;
                 }
                 (ast::Combine::Remove, None) => {
+                    let Some((names, group, constraint, _)) = groups.last_mut() else {
+                        self.error(p.span, "`-Pa` needs a group before it to remove from");
+                        ok = false;
+                        continue;
+                    };
                     for (v, n) in vars.iter().zip(&p.variables) {
-                        let Some(i) = vars_seen.iter().position(|s| s == v) else {
+                        let Some(i) = group.iter().position(|s| s == v) else {
                             self.error(
                                 n.span,
                                 format!(
-                                    "{} is not driven here, so `-Pa` cannot remove it",
+                                    "{} is not in the group before `-Pa`, so it cannot be removed",
                                     v.symbol()
                                 ),
                             );
                             ok = false;
                             continue;
                         };
-                        vars_seen.remove(i);
+                        group.remove(i);
                         names.remove(i);
-                        for prim in &mut primitives {
-                            if let Some(k) = prim.variables.iter().position(|x| x == v) {
-                                prim.variables.remove(k);
-                                if let PrimitiveConstraint::Goal(t) = &mut prim.constraint {
-                                    t.remove(k);
-                                }
-                            }
+                        if let Some(PrimitiveConstraint::Goal(t)) = constraint {
+                            t.remove(i);
                         }
-                        primitives.retain(|p| !p.variables.is_empty());
                     }
                 }
             }
@@ -622,7 +717,26 @@ impl Checker<'_> {
         if !ok {
             return None;
         }
-        let space = match self.space_of(&names, &vars_seen)? {
+        let mut primitives: Vec<Primitive> = Vec::new();
+        let mut names: Vec<Name> = Vec::new();
+        let mut vars_seen: Vec<Variable> = Vec::new();
+        for (group_names, vars, constraint, _) in groups {
+            for (v, n) in vars.iter().zip(&group_names) {
+                if vars_seen.contains(v) {
+                    self.error(n.span, format!("{} is already driven in this segment", v.symbol()));
+                    ok = false;
+                }
+            }
+            vars_seen.extend(&vars);
+            names.extend(group_names);
+            if let (Some(constraint), false) = (constraint, vars.is_empty()) {
+                primitives.push(Primitive { variables: vars, constraint });
+            }
+        }
+        if !ok {
+            return None;
+        }
+        let space = match self.segment_space(&names, &vars_seen)? {
             Some(s) => s,
             None => {
                 self.error(
@@ -698,6 +812,14 @@ impl Checker<'_> {
                 }
                 let goal = goals.first().map(|g| self.goal(g));
                 let path = paths.first().map(|p| self.path(p));
+                if let (Some(ast_path), Some(Some(pc))) = (paths.first(), &path) {
+                    self.path_against_goal(
+                        ast_path,
+                        pc,
+                        goal.as_ref().and_then(|g| g.as_ref()),
+                        goals.is_empty(),
+                    );
+                }
                 let duration =
                     durations.first().map(|d| self.positive(d, Dimension::Time, "the duration"));
                 ActionBody::Constraints {
@@ -845,7 +967,14 @@ impl Checker<'_> {
                         if (0.0..1.0).contains(&v) {
                             out.transition = v;
                         } else {
-                            self.error(q.span, "the transition overlap is between 0 and 100 %");
+                            let help = (q.unit.is_none() && q.value < 100.0).then(|| {
+                                format!("a bare number is a fraction: write `{} %`", q.value)
+                            });
+                            self.error_with_help(
+                                q.span,
+                                "the transition overlap is between 0 and 100 %",
+                                help,
+                            );
                         }
                     }
                 }
