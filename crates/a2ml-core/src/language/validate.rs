@@ -51,6 +51,9 @@ const AXES: [&str; 14] =
 const SHAPES: [&str; 4] = ["box", "sphere", "capsule", "cylinder"];
 const SETTINGS: [&str; 5] = ["rate", "solver", "seed", "transition", "frame"];
 
+/// A group of an explicit segment: names as written, variables, constraint.
+type Group = (Vec<Name>, Vec<Variable>, Option<PrimitiveConstraint>);
+
 struct Checker<'a> {
     errors: Vec<Diagnostic>,
     base_dir: Option<&'a Path>,
@@ -631,8 +634,7 @@ impl Checker<'_> {
     /// and holds its remaining variables.
     fn segment(&mut self, segment: &ast::Segment) -> Option<Segment> {
         // (names, variables, constraint) per group, after removals.
-        let mut groups: Vec<(Vec<Name>, Vec<Variable>, Option<PrimitiveConstraint>, bool)> =
-            Vec::new();
+        let mut groups: Vec<Group> = Vec::new();
         let mut ok = true;
         let prims = &segment.primitives;
         for (k, (combine, p)) in prims.iter().enumerate() {
@@ -651,12 +653,7 @@ impl Checker<'_> {
                     ok = false;
                 }
                 (ast::Combine::Add, None) => {
-                    groups.push((
-                        p.variables.clone(),
-                        vars,
-                        Some(PrimitiveConstraint::Hold),
-                        false,
-                    ));
+                    groups.push((p.variables.clone(), vars, Some(PrimitiveConstraint::Hold)));
                 }
                 (ast::Combine::Add, Some(c)) => {
                     let constraint = match c {
@@ -681,14 +678,14 @@ impl Checker<'_> {
                         ast::PrimitiveConstraint::Hold => Some(PrimitiveConstraint::Hold),
                     };
                     ok &= constraint.is_some();
-                    groups.push((p.variables.clone(), vars, constraint, true));
+                    groups.push((p.variables.clone(), vars, constraint));
                 }
                 (ast::Combine::Remove, Some(_)) => {
                     self.error(p.span, "`-Pa` removes variables: write them without a constraint");
                     ok = false;
                 }
                 (ast::Combine::Remove, None) => {
-                    let Some((names, group, constraint, _)) = groups.last_mut() else {
+                    let Some((names, group, constraint)) = groups.last_mut() else {
                         self.error(p.span, "`-Pa` needs a group before it to remove from");
                         ok = false;
                         continue;
@@ -720,7 +717,7 @@ impl Checker<'_> {
         let mut primitives: Vec<Primitive> = Vec::new();
         let mut names: Vec<Name> = Vec::new();
         let mut vars_seen: Vec<Variable> = Vec::new();
-        for (group_names, vars, constraint, _) in groups {
+        for (group_names, vars, constraint) in groups {
             for (v, n) in vars.iter().zip(&group_names) {
                 if vars_seen.contains(v) {
                     self.error(n.span, format!("{} is already driven in this segment", v.symbol()));
