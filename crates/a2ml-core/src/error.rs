@@ -1,4 +1,4 @@
-//! The crate-wide error, one variant per fallible stage.
+//! The crate-wide error, one variant per fallible stage, in pipeline order.
 
 /// Any error of the library.
 #[derive(Debug, thiserror::Error)]
@@ -6,10 +6,16 @@ pub enum Error {
     /// Loading the robot model failed.
     #[error(transparent)]
     Robot(#[from] crate::robot::RobotError),
-    /// A task file is unreadable or invalid.
-    #[error(transparent)]
-    Language(#[from] crate::language::LanguageError),
     /// A kinematic query has no answer.
     #[error(transparent)]
     Kinematics(#[from] crate::kinematics::KinematicsError),
+    /// A task file is unreadable or invalid.
+    #[error(transparent)]
+    Language(#[from] crate::language::LanguageError),
+    /// A task cannot be decomposed into actions and segments.
+    #[error(transparent)]
+    Decompose(#[from] crate::decompose::DecomposeError),
+    /// A reference profile cannot be built.
+    #[error(transparent)]
+    Profile(#[from] crate::profile::ProfileError),
 }

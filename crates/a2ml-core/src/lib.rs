@@ -3,13 +3,17 @@
 //!
 //! The modules follow the pipeline: [`robot`] (URDF to an arm model),
 //! [`kinematics`] (FK, CPSA and HAT states, Jacobians, IK), [`language`]
-//! (task files to a validated [`language::Task`]).
+//! (task files to a validated [`language::Task`]), [`decompose`] (action
+//! order and types), [`profile`] (bell profiles, references, weights and
+//! the joining of segments).
 
+pub mod decompose;
 pub mod error;
 pub mod kinematics;
 pub mod language;
 pub mod math;
 pub mod names;
+pub mod profile;
 pub mod robot;
 
 pub use error::Error;

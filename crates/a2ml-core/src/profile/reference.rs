@@ -1,0 +1,748 @@
+//! Reference paths of the movement primitives: the value of one state variable and its time
+//! derivative at any t, moving along the primitive's path with a bell speed (paper eq. 9).
+
+use super::{BellProfile, ProfileError};
+use crate::language::{Axis, BodyAxis, PathFeature, Target, ValueKind, Variable};
+use crate::math::{Real, Rotation3, Vector3, rotation_about, rotation_log, wrap_angle};
+
+/// Directions shorter than this are treated as undefined.
+const MIN_AXIS_NORM: Real = 1e-12;
+
+/// The shoulder frame Os and the hand frame Ow at the start of a primitive, in {b}: where the
+/// body axes r, l (Os columns 0, 1) and f, p (Ow columns 0, 1) are read (DESIGN.md §2-4).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyFrames {
+    /// Os = [r, l, r × l].
+    pub shoulder_frame: Rotation3,
+    /// Ow = [f, p, f × p].
+    pub ow: Rotation3,
+}
+
+impl BodyFrames {
+    /// The unit body axis in {b}.
+    pub fn axis(&self, axis: BodyAxis) -> Vector3 {
+        let (frame, column) = match axis {
+            BodyAxis::R => (&self.shoulder_frame, 0),
+            BodyAxis::L => (&self.shoulder_frame, 1),
+            BodyAxis::F => (&self.ow, 0),
+            BodyAxis::P => (&self.ow, 1),
+        };
+        frame.matrix().column(column).into()
+    }
+}
+
+/// The unit axis in {b} of a path feature: a fixed axis of {b} as given, or a body axis at
+/// its value in `frames` (the start of the primitive), negated when its sign is negative.
+///
+/// # Errors
+/// [`ProfileError::DegenerateAxis`] or [`ProfileError::NonFinite`] for an axis that cannot
+/// be normalised.
+pub fn resolve_axis(axis: &Axis, frames: &BodyFrames) -> Result<Vector3, ProfileError> {
+    match *axis {
+        Axis::Base(v) => unit(&v, "axis"),
+        Axis::Body(body, sign) => {
+            let v = frames.axis(body);
+            unit(&if sign < 0.0 { -v } else { v }, "body axis")
+        }
+    }
+}
+
+fn unit(v: &Vector3, what: &'static str) -> Result<Vector3, ProfileError> {
+    if !v.iter().all(|c| c.is_finite()) {
+        return Err(ProfileError::NonFinite { what });
+    }
+    let norm = v.norm();
+    if norm < MIN_AXIS_NORM {
+        return Err(ProfileError::DegenerateAxis { what });
+    }
+    Ok(v / norm)
+}
+
+fn finite_vector(v: &Vector3, what: &'static str) -> Result<(), ProfileError> {
+    if v.iter().all(|c| c.is_finite()) { Ok(()) } else { Err(ProfileError::NonFinite { what }) }
+}
+
+fn finite_rotation(r: &Rotation3, what: &'static str) -> Result<(), ProfileError> {
+    if r.matrix().iter().all(|c| c.is_finite()) {
+        Ok(())
+    } else {
+        Err(ProfileError::NonFinite { what })
+    }
+}
+
+fn finite_scalar(x: Real, what: &'static str) -> Result<(), ProfileError> {
+    if x.is_finite() { Ok(()) } else { Err(ProfileError::NonFinite { what }) }
+}
+
+/// The path of a wrist-position reference.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PositionPath {
+    /// Pw stays at the start (distance 0).
+    Hold,
+    /// Pw moves along a straight line from the start; the distance (m) is the bell's.
+    Line {
+        /// Unit direction in {b}.
+        direction: Vector3,
+    },
+    /// Pw turns about an axis through the shoulder S (the origin of {b}); the angle (rad) is
+    /// the bell's distance.
+    About {
+        /// Unit axis in {b}.
+        axis: Vector3,
+    },
+}
+
+/// The reference of Pw (m, in {b}): a line, a rotation about an axis through S, or a hold.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PositionReference {
+    start: Vector3,
+    path: PositionPath,
+    bell: BellProfile,
+}
+
+impl PositionReference {
+    /// Pw kept at `start` for `duration` (s).
+    ///
+    /// # Errors
+    /// Non-finite start or invalid duration.
+    pub fn hold(start: Vector3, duration: Real) -> Result<Self, ProfileError> {
+        finite_vector(&start, "start position")?;
+        Ok(Self { start, path: PositionPath::Hold, bell: BellProfile::new(duration, 0.0)? })
+    }
+
+    /// Pw along the line from `start` in `direction` (normalised) for the signed `length` (m):
+    /// the path feature `line d` with S = length.
+    ///
+    /// # Errors
+    /// Non-finite inputs, a zero direction, or an invalid duration.
+    pub fn line(
+        start: Vector3,
+        direction: &Vector3,
+        length: Real,
+        duration: Real,
+    ) -> Result<Self, ProfileError> {
+        finite_vector(&start, "start position")?;
+        finite_scalar(length, "line length")?;
+        let direction = unit(direction, "line direction")?;
+        let direction = if length < 0.0 { -direction } else { direction };
+        let bell = BellProfile::new(duration, length.abs())?;
+        Ok(Self { start, path: PositionPath::Line { direction }, bell })
+    }
+
+    /// Pw from `start` to `goal` along the straight line (the goal primitive's shortest path);
+    /// a hold when they coincide.
+    ///
+    /// # Errors
+    /// Non-finite inputs or an invalid duration.
+    pub fn goal(start: Vector3, goal: Vector3, duration: Real) -> Result<Self, ProfileError> {
+        finite_vector(&start, "start position")?;
+        finite_vector(&goal, "goal position")?;
+        let delta = goal - start;
+        let length = delta.norm();
+        if length == 0.0 {
+            return Self::hold(start, duration);
+        }
+        let bell = BellProfile::new(duration, length)?;
+        Ok(Self { start, path: PositionPath::Line { direction: delta / length }, bell })
+    }
+
+    /// Pw turning about `axis` (normalised, through S) by the signed `angle` (rad):
+    /// Pw(t) = Rot(axis, s(t)) Pw0.
+    ///
+    /// # Errors
+    /// Non-finite inputs, a zero axis, or an invalid duration.
+    pub fn about(
+        start: Vector3,
+        axis: &Vector3,
+        angle: Real,
+        duration: Real,
+    ) -> Result<Self, ProfileError> {
+        finite_vector(&start, "start position")?;
+        finite_scalar(angle, "angle")?;
+        let axis = unit(axis, "axis")?;
+        let axis = if angle < 0.0 { -axis } else { axis };
+        let bell = BellProfile::new(duration, angle.abs())?;
+        Ok(Self { start, path: PositionPath::About { axis }, bell })
+    }
+
+    /// Pw at t = 0 (m, {b}).
+    pub fn start(&self) -> Vector3 {
+        self.start
+    }
+
+    /// The path.
+    pub fn path(&self) -> PositionPath {
+        self.path
+    }
+
+    /// The speed profile: distance in m for a line, rad for a rotation.
+    pub fn bell(&self) -> &BellProfile {
+        &self.bell
+    }
+
+    /// Pw at t = T (m, {b}).
+    pub fn end(&self) -> Vector3 {
+        self.sample(self.bell.duration()).0
+    }
+
+    /// Pw (m) and its velocity (m/s) at t (s), both in {b}; t is clamped to [0, T].
+    pub fn sample(&self, t: Real) -> (Vector3, Vector3) {
+        let (s, speed) = (self.bell.progress(t), self.bell.speed(t));
+        match self.path {
+            PositionPath::Hold => (self.start, Vector3::zeros()),
+            PositionPath::Line { direction } => (self.start + direction * s, direction * speed),
+            PositionPath::About { axis } => {
+                let p = rotation_about(&axis, s) * self.start;
+                (p, axis.cross(&p) * speed)
+            }
+        }
+    }
+}
+
+/// The path of a rotation reference (Ow or Os).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RotationPath {
+    /// The rotation stays at the start (distance 0).
+    Hold,
+    /// R(t) = Rot(axis, s(t)) R0 about an axis fixed in {b}; the angle (rad) is the bell's
+    /// distance. A goal's geodesic is this with axis = R0 log(R0ᵀ R1)/|log(R0ᵀ R1)|.
+    About {
+        /// Unit axis in {b}.
+        axis: Vector3,
+    },
+}
+
+/// The reference of a rotation Ow or Os in {b}: a geodesic to a goal, a rotation about a
+/// fixed axis, or a hold. Its velocity is the angular velocity ω in {b} (`Ṙ = [ω]× R`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RotationReference {
+    start: Rotation3,
+    path: RotationPath,
+    bell: BellProfile,
+}
+
+impl RotationReference {
+    /// The rotation kept at `start` for `duration` (s).
+    ///
+    /// # Errors
+    /// Non-finite start or invalid duration.
+    pub fn hold(start: Rotation3, duration: Real) -> Result<Self, ProfileError> {
+        finite_rotation(&start, "start rotation")?;
+        Ok(Self { start, path: RotationPath::Hold, bell: BellProfile::new(duration, 0.0)? })
+    }
+
+    /// The geodesic from `start` to `goal`: R(t) = R0 exp(fraction(t) log(R0ᵀ R1)), the
+    /// rotation about the shortest axis by the geodesic angle in [0, π]; a hold when they
+    /// coincide.
+    ///
+    /// # Errors
+    /// Non-finite inputs or an invalid duration.
+    pub fn goal(start: Rotation3, goal: Rotation3, duration: Real) -> Result<Self, ProfileError> {
+        finite_rotation(&start, "start rotation")?;
+        finite_rotation(&goal, "goal rotation")?;
+        // The body-frame rotation vector φ = log(R0ᵀ R1). Since R0 exp(f [φ]×) R0ᵀ is the
+        // rotation about R0 φ by f |φ|, the geodesic R0 exp(f [φ]×) turns about the fixed
+        // axis R0 φ / |φ| of {b} by f |φ|.
+        let phi = rotation_log(&(start.inverse() * goal));
+        let angle = phi.norm();
+        if angle == 0.0 {
+            return Self::hold(start, duration);
+        }
+        let axis = start * (phi / angle);
+        Ok(Self {
+            start,
+            path: RotationPath::About { axis },
+            bell: BellProfile::new(duration, angle)?,
+        })
+    }
+
+    /// The rotation turning about `axis` (normalised, in {b}) by the signed `angle` (rad):
+    /// R(t) = Rot(axis, s(t)) R0.
+    ///
+    /// # Errors
+    /// Non-finite inputs, a zero axis, or an invalid duration.
+    pub fn about(
+        start: Rotation3,
+        axis: &Vector3,
+        angle: Real,
+        duration: Real,
+    ) -> Result<Self, ProfileError> {
+        finite_rotation(&start, "start rotation")?;
+        finite_scalar(angle, "angle")?;
+        let axis = unit(axis, "axis")?;
+        let axis = if angle < 0.0 { -axis } else { axis };
+        let bell = BellProfile::new(duration, angle.abs())?;
+        Ok(Self { start, path: RotationPath::About { axis }, bell })
+    }
+
+    /// The rotation at t = 0.
+    pub fn start(&self) -> Rotation3 {
+        self.start
+    }
+
+    /// The path.
+    pub fn path(&self) -> RotationPath {
+        self.path
+    }
+
+    /// The speed profile (distance in rad).
+    pub fn bell(&self) -> &BellProfile {
+        &self.bell
+    }
+
+    /// The rotation at t = T.
+    pub fn end(&self) -> Rotation3 {
+        self.sample(self.bell.duration()).0
+    }
+
+    /// The rotation and its angular velocity (rad/s, in {b}) at t (s), clamped to [0, T].
+    pub fn sample(&self, t: Real) -> (Rotation3, Vector3) {
+        match self.path {
+            RotationPath::Hold => (self.start, Vector3::zeros()),
+            RotationPath::About { axis } => {
+                let turn = rotation_about(&axis, self.bell.progress(t));
+                let r = Rotation3::from_matrix_unchecked(turn * self.start.matrix());
+                (r, axis * self.bell.speed(t))
+            }
+        }
+    }
+}
+
+/// The reference of an angle θsw or θe (rad): a signed change with a bell speed, or a hold.
+///
+/// A periodic angle (θsw) is reported wrapped into (-π, π], and its goal is reached the
+/// shorter way round; θe is not wrapped and a goal is reached by the plain difference.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AngleReference {
+    start: Real,
+    /// +1 or -1: the sign of the change.
+    direction: Real,
+    bell: BellProfile,
+    periodic: bool,
+}
+
+impl AngleReference {
+    /// The angle kept at `start` (rad) for `duration` (s).
+    ///
+    /// # Errors
+    /// Non-finite start or invalid duration.
+    pub fn hold(start: Real, periodic: bool, duration: Real) -> Result<Self, ProfileError> {
+        Self::by(start, 0.0, periodic, duration)
+    }
+
+    /// The angle changing from `start` by the signed `change` (rad): the feature `by S`.
+    ///
+    /// # Errors
+    /// Non-finite inputs or an invalid duration.
+    pub fn by(
+        start: Real,
+        change: Real,
+        periodic: bool,
+        duration: Real,
+    ) -> Result<Self, ProfileError> {
+        finite_scalar(start, "start angle")?;
+        finite_scalar(change, "angle change")?;
+        let start = if periodic { wrap_angle(start) } else { start };
+        let direction = if change < 0.0 { -1.0 } else { 1.0 };
+        Ok(Self { start, direction, bell: BellProfile::new(duration, change.abs())?, periodic })
+    }
+
+    /// The angle from `start` to `goal` (rad): the shortest signed angle when periodic
+    /// (wrap_angle(goal - start)), the plain difference otherwise.
+    ///
+    /// # Errors
+    /// Non-finite inputs or an invalid duration.
+    pub fn goal(
+        start: Real,
+        goal: Real,
+        periodic: bool,
+        duration: Real,
+    ) -> Result<Self, ProfileError> {
+        finite_scalar(goal, "goal angle")?;
+        let change = if periodic { wrap_angle(goal - start) } else { goal - start };
+        Self::by(start, change, periodic, duration)
+    }
+
+    /// The angle at t = 0 (rad; wrapped when periodic).
+    pub fn start(&self) -> Real {
+        self.start
+    }
+
+    /// The signed change over the whole primitive (rad).
+    pub fn change(&self) -> Real {
+        self.direction * self.bell.distance()
+    }
+
+    /// Whether the angle is wrapped into (-π, π].
+    pub fn is_periodic(&self) -> bool {
+        self.periodic
+    }
+
+    /// The speed profile (distance |change| in rad).
+    pub fn bell(&self) -> &BellProfile {
+        &self.bell
+    }
+
+    /// The angle at t = T (rad).
+    pub fn end(&self) -> Real {
+        self.sample(self.bell.duration()).0
+    }
+
+    /// The angle (rad) and its rate (rad/s) at t (s), clamped to [0, T].
+    pub fn sample(&self, t: Real) -> (Real, Real) {
+        let value = self.start + self.direction * self.bell.progress(t);
+        let value = if self.periodic { wrap_angle(value) } else { value };
+        (value, self.direction * self.bell.speed(t))
+    }
+}
+
+/// The reference of one state variable over a primitive, typed by the variable's kind.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Reference {
+    /// Pw.
+    Position(PositionReference),
+    /// Ow or Os.
+    Rotation(RotationReference),
+    /// θsw (periodic) or θe.
+    Angle(AngleReference),
+}
+
+/// A reference's value and time derivative at one instant, in {b}.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Sample {
+    /// Pw.
+    Position {
+        /// Position (m).
+        value: Vector3,
+        /// Linear velocity (m/s).
+        velocity: Vector3,
+    },
+    /// Ow or Os.
+    Rotation {
+        /// Rotation.
+        value: Rotation3,
+        /// Angular velocity (rad/s) in {b}.
+        angular_velocity: Vector3,
+    },
+    /// θsw or θe.
+    Angle {
+        /// Angle (rad).
+        value: Real,
+        /// Rate (rad/s).
+        rate: Real,
+    },
+}
+
+impl Sample {
+    /// The value alone.
+    pub fn value(&self) -> Target {
+        match *self {
+            Sample::Position { value, .. } => Target::Position(value),
+            Sample::Rotation { value, .. } => Target::Rotation(value),
+            Sample::Angle { value, .. } => Target::Angle(value),
+        }
+    }
+}
+
+fn kind_of(value: &Target) -> ValueKind {
+    match value {
+        Target::Position(_) => ValueKind::Position,
+        Target::Rotation(_) => ValueKind::Rotation,
+        Target::Angle(_) => ValueKind::Angle,
+    }
+}
+
+fn check_kind(variable: Variable, value: &Target) -> Result<(), ProfileError> {
+    let (expected, found) = (variable.kind(), kind_of(value));
+    if expected == found {
+        Ok(())
+    } else {
+        Err(ProfileError::KindMismatch { variable, expected, found })
+    }
+}
+
+impl Reference {
+    /// The goal primitive MP^g(G, T) of `variable` from `start`: a straight line for Pw, the
+    /// geodesic for Ow/Os, the shortest signed angle for θsw, the plain difference for θe.
+    ///
+    /// # Errors
+    /// [`ProfileError::KindMismatch`] when `start` or `goal` is not of the variable's kind;
+    /// non-finite values or an invalid duration.
+    pub fn goal(
+        variable: Variable,
+        start: Target,
+        goal: Target,
+        duration: Real,
+    ) -> Result<Self, ProfileError> {
+        check_kind(variable, &start)?;
+        check_kind(variable, &goal)?;
+        Ok(match (start, goal) {
+            (Target::Position(a), Target::Position(b)) => {
+                Reference::Position(PositionReference::goal(a, b, duration)?)
+            }
+            (Target::Rotation(a), Target::Rotation(b)) => {
+                Reference::Rotation(RotationReference::goal(a, b, duration)?)
+            }
+            (Target::Angle(a), Target::Angle(b)) => Reference::Angle(AngleReference::goal(
+                a,
+                b,
+                variable == Variable::Swivel,
+                duration,
+            )?),
+            // check_kind made both kinds the variable's; kept total without a panic.
+            _ => {
+                let found = kind_of(&goal);
+                return Err(ProfileError::KindMismatch {
+                    variable,
+                    expected: variable.kind(),
+                    found,
+                });
+            }
+        })
+    }
+
+    /// The path primitive MP^p(P, S, T) of `variable` from `start`: `line` (Pw), `about`
+    /// (Pw about an axis through S, Ow, Os), `by` (θsw, θe) or `hold` (any). Body axes are
+    /// read from `frames`, the frames at the start of the primitive.
+    ///
+    /// # Errors
+    /// [`ProfileError::FeatureMismatch`] when the feature does not apply to the variable,
+    /// [`ProfileError::MissingSize`] when its size is still open (Opt2 decides it),
+    /// [`ProfileError::KindMismatch`], degenerate axes, non-finite values, invalid duration.
+    pub fn path(
+        variable: Variable,
+        start: Target,
+        feature: &PathFeature,
+        frames: &BodyFrames,
+        duration: Real,
+    ) -> Result<Self, ProfileError> {
+        check_kind(variable, &start)?;
+        let keyword = match feature {
+            PathFeature::Line { .. } => "line",
+            PathFeature::About { .. } => "about",
+            PathFeature::By { .. } => "by",
+            PathFeature::Hold => "hold",
+        };
+        let missing = || ProfileError::MissingSize { variable, feature: keyword };
+        Ok(match (*feature, start) {
+            (PathFeature::Hold, _) => return Self::hold(variable, start, duration),
+            (PathFeature::Line { direction, length }, Target::Position(p)) => {
+                let length = length.ok_or_else(missing)?;
+                Reference::Position(PositionReference::line(p, &direction, length, duration)?)
+            }
+            (PathFeature::About { axis, angle }, Target::Position(p)) => {
+                let angle = angle.ok_or_else(missing)?;
+                let axis = resolve_axis(&axis, frames)?;
+                Reference::Position(PositionReference::about(p, &axis, angle, duration)?)
+            }
+            (PathFeature::About { axis, angle }, Target::Rotation(r)) => {
+                let angle = angle.ok_or_else(missing)?;
+                let axis = resolve_axis(&axis, frames)?;
+                Reference::Rotation(RotationReference::about(r, &axis, angle, duration)?)
+            }
+            (PathFeature::By { angle }, Target::Angle(a)) => Reference::Angle(AngleReference::by(
+                a,
+                angle,
+                variable == Variable::Swivel,
+                duration,
+            )?),
+            _ => return Err(ProfileError::FeatureMismatch { variable, feature: keyword }),
+        })
+    }
+
+    /// `variable` kept at `start` for `duration` (s): the hold primitive (P = void, S = 0).
+    ///
+    /// # Errors
+    /// [`ProfileError::KindMismatch`], a non-finite start or an invalid duration.
+    pub fn hold(variable: Variable, start: Target, duration: Real) -> Result<Self, ProfileError> {
+        check_kind(variable, &start)?;
+        Ok(match start {
+            Target::Position(p) => Reference::Position(PositionReference::hold(p, duration)?),
+            Target::Rotation(r) => Reference::Rotation(RotationReference::hold(r, duration)?),
+            Target::Angle(a) => {
+                Reference::Angle(AngleReference::hold(a, variable == Variable::Swivel, duration)?)
+            }
+        })
+    }
+
+    /// The value and its time derivative at t (s), clamped to [0, T].
+    pub fn sample(&self, t: Real) -> Sample {
+        match self {
+            Reference::Position(r) => {
+                let (value, velocity) = r.sample(t);
+                Sample::Position { value, velocity }
+            }
+            Reference::Rotation(r) => {
+                let (value, angular_velocity) = r.sample(t);
+                Sample::Rotation { value, angular_velocity }
+            }
+            Reference::Angle(r) => {
+                let (value, rate) = r.sample(t);
+                Sample::Angle { value, rate }
+            }
+        }
+    }
+
+    /// The speed profile: its duration is the primitive's T, its distance the path's length
+    /// (m for Pw lines, rad otherwise).
+    pub fn bell(&self) -> &BellProfile {
+        match self {
+            Reference::Position(r) => r.bell(),
+            Reference::Rotation(r) => r.bell(),
+            Reference::Angle(r) => r.bell(),
+        }
+    }
+
+    /// The duration T (s).
+    pub fn duration(&self) -> Real {
+        self.bell().duration()
+    }
+
+    /// The value at t = 0.
+    pub fn start(&self) -> Target {
+        match self {
+            Reference::Position(r) => Target::Position(r.start()),
+            Reference::Rotation(r) => Target::Rotation(r.start()),
+            Reference::Angle(r) => Target::Angle(r.start()),
+        }
+    }
+
+    /// The value at t = T: where the next segment of this variable starts.
+    pub fn end(&self) -> Target {
+        self.sample(self.duration()).value()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::{PI, rotation_distance};
+
+    fn rot(axis: Vector3, angle: Real) -> Rotation3 {
+        Rotation3::from_matrix_unchecked(rotation_about(&axis.normalize(), angle))
+    }
+
+    #[test]
+    fn geodesic_matches_the_exponential_form() {
+        let r0 = rot(Vector3::new(0.3, -0.2, 0.9), 0.7);
+        let r1 = rot(Vector3::new(-0.5, 0.4, 0.1), 2.1);
+        let reference = RotationReference::goal(r0, r1, 1.5).expect("valid");
+        let phi = rotation_log(&(r0.inverse() * r1));
+        for t in [0.0, 0.2, 0.75, 1.1, 1.5] {
+            let f = reference.bell().fraction(t);
+            let expected = r0 * Rotation3::new(phi * f);
+            let (r, omega) = reference.sample(t);
+            assert!(rotation_distance(&r, &expected) < 1e-14, "t {t}");
+            // ω in {b} = R0 φ f'(t).
+            let expected_omega = r0 * phi * reference.bell().fraction_rate(t);
+            assert!((omega - expected_omega).norm() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn body_axes_come_from_the_start_frames() {
+        let frames = BodyFrames {
+            shoulder_frame: rot(Vector3::new(1.0, 2.0, 3.0), 0.4),
+            ow: rot(Vector3::new(-1.0, 0.5, 0.2), 1.3),
+        };
+        let col = |r: &Rotation3, i: usize| -> Vector3 { r.matrix().column(i).into() };
+        let cases = [
+            (BodyAxis::R, col(&frames.shoulder_frame, 0)),
+            (BodyAxis::L, col(&frames.shoulder_frame, 1)),
+            (BodyAxis::F, col(&frames.ow, 0)),
+            (BodyAxis::P, col(&frames.ow, 1)),
+        ];
+        for (body, expected) in cases {
+            let plus = resolve_axis(&Axis::Body(body, 1.0), &frames).expect("unit");
+            let minus = resolve_axis(&Axis::Body(body, -1.0), &frames).expect("unit");
+            assert!((plus - expected).norm() < 1e-15);
+            assert!((minus + expected).norm() < 1e-15);
+        }
+        assert!(matches!(
+            resolve_axis(&Axis::Base(Vector3::zeros()), &frames),
+            Err(ProfileError::DegenerateAxis { .. })
+        ));
+    }
+
+    #[test]
+    fn swivel_goal_takes_the_short_way_round() {
+        let r = AngleReference::goal(3.0, -3.0, true, 1.0).expect("valid");
+        assert!((r.change() - (2.0 * PI - 6.0)).abs() < 1e-15);
+        assert!((wrap_angle(r.end() + 3.0)).abs() < 1e-12);
+        // Wrapped throughout.
+        for k in 0..=10 {
+            let (v, _) = r.sample(k as Real / 10.0);
+            assert!(v > -PI && v <= PI);
+        }
+        let e = AngleReference::goal(3.0, -3.0, false, 1.0).expect("valid");
+        assert!((e.change() + 6.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn coincident_goals_hold() {
+        let p = Vector3::new(0.1, 0.2, 0.3);
+        let r = Reference::goal(Variable::Pw, Target::Position(p), Target::Position(p), 1.0)
+            .expect("valid");
+        assert!(matches!(r, Reference::Position(ref x) if x.path() == PositionPath::Hold));
+        let o = rot(Vector3::z(), 0.3);
+        let r = Reference::goal(Variable::Ow, Target::Rotation(o), Target::Rotation(o), 1.0)
+            .expect("valid");
+        assert!(matches!(r, Reference::Rotation(ref x) if x.path() == RotationPath::Hold));
+        match r.sample(0.5) {
+            Sample::Rotation { value, angular_velocity } => {
+                assert_eq!(value, o);
+                assert_eq!(angular_velocity, Vector3::zeros());
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn mismatches_are_errors() {
+        let frames =
+            BodyFrames { shoulder_frame: Rotation3::identity(), ow: Rotation3::identity() };
+        let line = PathFeature::Line { direction: Vector3::x(), length: Some(0.1) };
+        assert!(matches!(
+            Reference::path(
+                Variable::Ow,
+                Target::Rotation(Rotation3::identity()),
+                &line,
+                &frames,
+                1.0
+            ),
+            Err(ProfileError::FeatureMismatch { variable: Variable::Ow, feature: "line" })
+        ));
+        assert!(matches!(
+            Reference::goal(Variable::Pw, Target::Angle(0.0), Target::Angle(1.0), 1.0),
+            Err(ProfileError::KindMismatch { variable: Variable::Pw, .. })
+        ));
+        let open = PathFeature::Line { direction: Vector3::x(), length: None };
+        assert!(matches!(
+            Reference::path(Variable::Pw, Target::Position(Vector3::x()), &open, &frames, 1.0),
+            Err(ProfileError::MissingSize { feature: "line", .. })
+        ));
+        assert!(matches!(
+            Reference::goal(
+                Variable::Pw,
+                Target::Position(Vector3::x()),
+                Target::Position(Vector3::new(Real::NAN, 0.0, 0.0)),
+                1.0
+            ),
+            Err(ProfileError::NonFinite { .. })
+        ));
+        assert!(matches!(
+            Reference::hold(Variable::Elbow, Target::Angle(1.0), -1.0),
+            Err(ProfileError::InvalidDuration { .. })
+        ));
+    }
+
+    #[test]
+    fn negative_sizes_reverse_the_direction() {
+        let p0 = Vector3::new(0.3, 0.0, -0.2);
+        let r = PositionReference::line(p0, &Vector3::y(), -0.1, 1.0).expect("valid");
+        assert!((r.end() - (p0 - 0.1 * Vector3::y())).norm() < 1e-15);
+        let r = RotationReference::about(Rotation3::identity(), &Vector3::z(), -0.5, 1.0)
+            .expect("valid");
+        assert!(rotation_distance(&r.end(), &rot(Vector3::z(), -0.5)) < 1e-15);
+    }
+}
