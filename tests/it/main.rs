@@ -6,6 +6,7 @@ mod errors;
 mod ik;
 mod jacobians;
 mod language;
+mod opt;
 mod profile;
 mod robots;
 mod swivel;

@@ -2,15 +2,19 @@
 //!
 //! Entry points: [`order`] (the action sequence: a STRIPS plan from `init`
 //! to `goal`, or the written order), [`classify`] (an action's type I-VII
-//! from its goal and path constraints) and [`segment_pattern`] (1, 2 or 3).
+//! from its goal and path constraints), [`segment_pattern`] (1, 2 or 3),
+//! and the optimisers [`opt1`] and [`opt2`] that reconcile constraints
+//! given in different spaces.
 //! Actions are referred to by their index in `Task::actions`.
 
 mod classify;
+mod opt;
 mod strips;
 
 pub use classify::{
     ActionType, Classification, Combination, SegmentPattern, classify, segment_pattern,
 };
+pub use opt::{ArmState, OptError, OptOptions, OptSolution, along_path, goal_error, opt1, opt2};
 pub use strips::{StripsOptions, order, order_with};
 
 use crate::language::Variable;
