@@ -9,4 +9,5 @@ mod language;
 mod opt;
 mod profile;
 mod robots;
+mod segments;
 mod swivel;

@@ -7,10 +7,15 @@
 //! given in different spaces.
 //! Actions are referred to by their index in `Task::actions`.
 
+mod build;
 mod classify;
 mod opt;
 mod strips;
 
+pub use build::{
+    DecomposeOptions, Decomposition, FittsLaw, OptReport, PlannedAction, PlannedSegment, decompose,
+    segment_goal_error,
+};
 pub use classify::{
     ActionType, Classification, Combination, SegmentPattern, classify, segment_pattern,
 };
@@ -69,6 +74,22 @@ pub enum DecomposeError {
         action: String,
         /// What it constrains.
         combination: Combination,
+    },
+    /// The task gives no start configuration.
+    #[error("task `{task}` has no `start`: give the joint angles or a start state")]
+    NoStart {
+        /// The task.
+        task: String,
+    },
+    /// A segment's goal cannot be reached within the joint limits.
+    #[error("action `{action}`, segment {}: {reason}", segment + 1)]
+    Unreachable {
+        /// The action.
+        action: String,
+        /// Segment index (0-based).
+        segment: usize,
+        /// Why.
+        reason: String,
     },
     /// A path leaves out its size where no optimiser chooses it.
     #[error(

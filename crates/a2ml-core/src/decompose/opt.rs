@@ -50,7 +50,7 @@ impl ArmState {
 
     /// The state whose variables of `space` take `values` (in the order of
     /// [`Space::variables`]), the other space following by the mapping.
-    fn from_space(robot: &Robot, space: Space, values: &[Target; 3]) -> Option<Self> {
+    pub fn from_space(robot: &Robot, space: Space, values: &[Target; 3]) -> Option<Self> {
         match (space, values) {
             (Space::Cpsa, [Target::Position(pw), Target::Rotation(ow), Target::Angle(swivel)]) => {
                 let cpsa = CpsaState { pw: *pw, ow: *ow, swivel: wrap_angle(*swivel) };
@@ -67,7 +67,8 @@ impl ArmState {
         }
     }
 
-    fn space_values(&self, space: Space) -> [Target; 3] {
+    /// The values of `space`'s variables, in the order of [`Space::variables`].
+    pub fn space_values(&self, space: Space) -> [Target; 3] {
         space.variables().map(|v| self.value(v))
     }
 }
