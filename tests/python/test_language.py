@@ -43,7 +43,7 @@ task push {
   }
   action slide {
     pre { empty } add { done }
-    path Pw line [0, 1, 0] 20 cm, Ow hold, θsw hold : soft
+    path Pw line [0, 1, 0] 20 cm, Ow hold, θsw hold : hard
     solver qp
   }
   action turn explicit {
@@ -139,7 +139,7 @@ def test_path_action_in_si(task: Task) -> None:
     assert slide["kind"] == "constraints" and slide["solver"] == "qp"
     assert slide["goal"] is None and slide["duration"] is None
     path = slide["path"]
-    assert path["space"] == "cpsa" and path["hard"] is False
+    assert path["space"] == "cpsa" and path["hard"] is True
     line, hold_ow, hold_swivel = path["items"]
     assert line["variables"] == ["pw"]
     assert line["feature"]["kind"] == "line"

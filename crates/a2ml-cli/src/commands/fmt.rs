@@ -1,7 +1,6 @@
-//! `a2ml fmt`: a task file in canonical form ([`language::format`]): printed,
-//! checked (`--check`) or written back (`--write`). Only the syntax matters
-//! here, so a file whose robot is missing still formats. Comments are not
-//! part of the syntax tree and so are dropped; a warning says so.
+//! `a2ml fmt`: a task file in canonical form ([`language::format`]), comments
+//! kept: printed, checked (`--check`) or written back (`--write`). Only the
+//! syntax matters here, so a file whose robot is missing still formats.
 
 use std::fs;
 use std::io::Write;
@@ -22,7 +21,7 @@ Examples:
   a2ml fmt --check examples/*.a2ml
   a2ml fmt --write task.a2ml
 
-Comments are dropped: the canonical form holds only what the parser keeps.
+Comments are kept, each beside the line of the node it was written with.
 
 Exit codes: 0 success, 1 a file cannot be read or written, 2 a syntax error
 or (with --check) a file not in canonical form (1 wins when both happen).")]
@@ -72,9 +71,6 @@ pub fn run(args: &FmtArgs) -> Result<(), CliError> {
             }
         };
         let canonical = language::format(&tree);
-        if has_comments(&text) {
-            output::warn(&format!("{}: comments are not kept by fmt", path.display()));
-        }
         if args.check {
             if canonical != text {
                 output::report(&format!(
@@ -95,25 +91,6 @@ pub fn run(args: &FmtArgs) -> Result<(), CliError> {
         }
     }
     tally.finish(if args.check { "failed the check" } else { "could not be formatted" })
-}
-
-/// Whether a text that parses holds a comment. Exact for such a text: `#`
-/// and `/` occur in it only in comments and in strings, and a string is a
-/// pair of `"` on one line.
-fn has_comments(text: &str) -> bool {
-    text.lines().any(|line| {
-        let mut in_string = false;
-        let mut chars = line.chars().peekable();
-        while let Some(c) = chars.next() {
-            match c {
-                '"' => in_string = !in_string,
-                '#' if !in_string => return true,
-                '/' if !in_string && chars.peek() == Some(&'/') => return true,
-                _ => {}
-            }
-        }
-        false
-    })
 }
 
 /// Replaces the file (the target, if `path` is a symbolic link) with `text`
@@ -140,18 +117,4 @@ fn write_in_place(path: &Path, text: &str) -> Result<(), String> {
         let _ = fs::remove_file(&temporary);
     }
     written.map_err(fail)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn comments_outside_strings_only() {
-        assert!(has_comments("robot \"a.urdf\" # the arm\n"));
-        assert!(has_comments("// header\nrobot \"a.urdf\"\n"));
-        assert!(!has_comments("robot \"a#b//c.urdf\"\n"));
-        assert!(has_comments("task t { action a \"x # y\" { // why\n} }\n"));
-        assert!(!has_comments("start [0, 0, 0, 0, 0, 0, 0]\n"));
-    }
 }

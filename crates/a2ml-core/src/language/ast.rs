@@ -1,6 +1,7 @@
 //! The typed syntax tree of an A2ML file, as written: names are strings,
 //! numbers carry the unit they were written with, and every node has the
-//! byte span of its text. [`super::validate`] turns it into a [`super::Task`].
+//! byte span of its text. Comments stand apart, in [`File::comments`].
+//! Validation turns the tree into a [`super::Task`].
 
 use crate::math::Real;
 
@@ -97,10 +98,38 @@ impl Value {
 }
 
 /// A whole A2ML file.
+///
+/// Two files are equal when their items are and their comments have the
+/// same texts in the same order.
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
 pub struct File {
     /// Top-level items in source order.
     pub items: Vec<Item>,
+    /// Every comment in source order; [`super::format()`] puts each back
+    /// beside the node it was written with.
+    pub comments: Vec<Comment>,
+}
+
+/// A `#` or `//` comment, which runs to the end of its line.
+///
+/// Comments compare by text alone: where one sits is layout.
+#[derive(Debug, Clone, Eq, serde::Serialize)]
+pub struct Comment {
+    /// The text from `#` or `//` on, without the line break and trailing
+    /// whitespace.
+    pub text: String,
+    /// Whether it stands alone on its line (else code comes before it).
+    pub own_line: bool,
+    /// One past the last byte of the code before it, 0 if there is none.
+    pub code_before: usize,
+    /// The text.
+    pub span: Span,
+}
+
+impl PartialEq for Comment {
+    fn eq(&self, other: &Self) -> bool {
+        self.text == other.text
+    }
 }
 
 /// A top-level item.
@@ -137,8 +166,10 @@ pub enum Start {
 pub struct Scene {
     /// Obstacles in source order.
     pub obstacles: Vec<Obstacle>,
-    /// The `scene` keyword.
+    /// The whole block, from `scene` to the closing brace.
     pub span: Span,
+    /// The braces and what is between them.
+    pub braces: Span,
 }
 
 /// `name = shape`.
@@ -196,8 +227,10 @@ pub enum Shape {
 pub struct Settings {
     /// Entries in source order.
     pub entries: Vec<Setting>,
-    /// The `settings` keyword.
+    /// The whole block, from `settings` to the closing brace.
     pub span: Span,
+    /// The braces and what is between them.
+    pub braces: Span,
 }
 
 /// One setting.
@@ -240,8 +273,10 @@ pub struct Task {
     pub goal: Vec<Facts>,
     /// Actions in source order.
     pub actions: Vec<Action>,
-    /// The header.
+    /// The task's name.
     pub span: Span,
+    /// The braces and what is between them.
+    pub braces: Span,
 }
 
 /// One action.
@@ -263,6 +298,8 @@ pub struct Action {
     pub body: ActionBody,
     /// The action's name.
     pub span: Span,
+    /// The braces and what is between them.
+    pub braces: Span,
 }
 
 /// The two forms of an action.
@@ -361,6 +398,8 @@ pub struct Segment {
     pub primitives: Vec<(Combine, Primitive)>,
     /// The `segment` keyword.
     pub span: Span,
+    /// The braces and what is between them.
+    pub braces: Span,
 }
 
 /// How a primitive joins the ones before it.

@@ -1,15 +1,20 @@
 //! The canonical text of a syntax tree: what `a2ml fmt` prints.
 //!
 //! The law: for every text that parses, `parse_ast(format(parse_ast(text)))`
-//! equals `parse_ast(text)`, and formatting is idempotent. Comments are not
-//! in the tree, so they are dropped. What the tree does not keep is printed
-//! one fixed way: `>` for priority, no `+Se`, statements of an action in the
-//! order pre, add, del, goal, path, duration, solver.
+//! equals `parse_ast(text)`, comments included, and formatting is
+//! idempotent. What the tree does not keep is printed one fixed way: `>` for
+//! priority, no `+Se`, statements of an action in the order pre, add, del,
+//! goal, path, duration, solver. Comments go back beside the line of the
+//! node they were written with, and move with it: a statement that canonical
+//! order moves past another takes its comments along, which is the one way
+//! the comments' order can change.
+
+use std::collections::BTreeMap;
 
 use super::ast::{
-    Action, ActionBody, Combine, Facts, Feature, File, Goal, GoalTerm, Item, Name, Obstacle, Path,
-    Primitive, PrimitiveConstraint, Quantity, Scene, Segment, Setting, SettingValue, Settings,
-    Shape, Start, Task, Value, Vector,
+    Action, ActionBody, Combine, Comment, Facts, Feature, File, Goal, GoalTerm, Item, Name,
+    Obstacle, Path, Primitive, PrimitiveConstraint, Quantity, Scene, Segment, Setting,
+    SettingValue, Settings, Shape, Span, Start, Task, Value, Vector,
 };
 use crate::math::Real;
 
@@ -19,98 +24,283 @@ const INDENT: usize = 2;
 /// Prints a syntax tree in the canonical layout: two-space indentation, one
 /// statement per line, a blank line between blocks, scene obstacles aligned
 /// in columns, numbers in their shortest form that reads back to the same
-/// `f64`, units and names as written. Comments are not in the tree and so
-/// are not printed.
+/// `f64`, units and names as written.
+///
+/// Comments come back beside the lines of their nodes. One on a line of
+/// its own stays on a line of its own, at the indentation of the first node
+/// that starts after it and just before it; one after code goes at the end
+/// of the line that prints that code, one space after it. A line takes one
+/// comment at its end: more after it, and those written inside a statement
+/// printed on one line (a segment, a `path` over several lines), follow it
+/// on lines of their own. A comment after a node's first words (its
+/// keyword, a `+Tr`, or a `+Se` before an action) follows the node's line.
+/// Comments after a block's last node go before its closing brace, those
+/// after the last item at the end.
 pub fn format(file: &File) -> String {
-    let one_liner = |item: &Item| matches!(item, Item::Robot(_) | Item::Start(_));
-    let mut p = Printer::default();
-    let mut previous: Option<&Item> = None;
-    for item in &file.items {
-        // `robot` and `start` stay together as the header; blocks stand apart.
-        if previous.is_some_and(|prev| !(one_liner(prev) && one_liner(item))) {
-            p.blank();
-        }
-        match item {
-            Item::Robot(path) => p.line(&format!("robot {}", string(path))),
-            Item::Start(start) => p.line(&self::start(start)),
-            Item::Scene(scene) => p.scene(scene),
-            Item::Settings(settings) => p.settings(settings),
-            Item::Task(task) => p.task(task),
-        }
-        previous = Some(item);
-    }
-    p.out
+    // A first pass learns which node each printed line stands for; the
+    // comments are placed against those lines, then printed in a second.
+    let mut layout = Printer::default();
+    layout.file(file);
+    let comments = Placement::new(&file.comments, layout.anchors);
+    let mut printer = Printer { comments, ..Printer::default() };
+    printer.file(file);
+    printer.finish()
 }
 
-/// Lines with indentation.
+/// The source text a printed line stands for: a statement whole, a block's
+/// head to its `{`, or a block's `}`. A keyword or `+Tr` before the first
+/// byte recorded here still belongs to the line; comments after it do too.
+#[derive(Debug, Clone, Copy)]
+struct Anchor {
+    /// The first byte: what the line is known by.
+    start: usize,
+    /// One past the last byte.
+    end: usize,
+}
+
+impl Anchor {
+    /// A statement that runs from the start of `first` to the end of `last`.
+    fn statement(first: Span, last: Span) -> Self {
+        Self { start: first.start, end: last.end.max(first.end) }
+    }
+
+    /// A block's head, from `start` to its opening brace.
+    fn open(start: usize, braces: Span) -> Self {
+        Self { start, end: braces.start + 1 }
+    }
+
+    /// A block's closing brace.
+    fn close(braces: Span) -> Self {
+        Self { start: braces.end.saturating_sub(1), end: braces.end }
+    }
+}
+
+/// Each comment assigned to a printed line, by the line's [`Anchor::start`].
 #[derive(Default)]
-struct Printer {
+struct Placement<'a> {
+    /// Comments on lines of their own before the line.
+    before: BTreeMap<usize, Vec<&'a Comment>>,
+    /// Comments after the line: the first on the line itself if it followed
+    /// code in the source, the others on lines of their own.
+    after: BTreeMap<usize, Vec<&'a Comment>>,
+    /// Comments after the last line.
+    end: Vec<&'a Comment>,
+}
+
+impl<'a> Placement<'a> {
+    /// Places `comments` against the printed lines, so that they come out
+    /// in source order unless the lines do not.
+    fn new(comments: &'a [Comment], mut anchors: Vec<Anchor>) -> Self {
+        anchors.sort_by_key(|a| a.start);
+        let mut placement = Self::default();
+        for comment in comments {
+            let at = comment.span.start;
+            let first_after = anchors.partition_point(|a| a.start < at);
+            let previous = first_after.checked_sub(1).map(|i| anchors[i]);
+            let next = anchors.get(first_after).copied();
+            let previous_end = previous.map_or(0, |a| a.end);
+            let (list, anchor) = if previous.is_some_and(|a| at < a.end) {
+                // Inside a line's text: after that line.
+                (&mut placement.after, previous)
+            } else if comment.code_before > previous_end {
+                // After the first words of the next line, such as a keyword
+                // or `+Tr`, which its anchor does not cover.
+                (&mut placement.after, next)
+            } else if comment.own_line {
+                (&mut placement.before, next)
+            } else {
+                (&mut placement.after, previous)
+            };
+            match anchor {
+                Some(anchor) => list.entry(anchor.start).or_default().push(comment),
+                None => placement.end.push(comment),
+            }
+        }
+        placement
+    }
+}
+
+/// Lines with indentation and the comments that go between them.
+#[derive(Default)]
+struct Printer<'a> {
     out: String,
     depth: usize,
+    /// The printed lines' nodes, in print order.
+    anchors: Vec<Anchor>,
+    /// The comments still to print.
+    comments: Placement<'a>,
+    /// Comments due on lines of their own before the next line.
+    pending: Vec<&'a Comment>,
 }
 
-impl Printer {
-    /// Writes one statement at the current depth. A `\n` inside `text` (see
-    /// [`gap`]) continues the statement on a line indented two levels more.
-    fn line(&mut self, text: &str) {
-        for (i, part) in text.split('\n').enumerate() {
-            let depth = if i == 0 { self.depth } else { self.depth + 2 };
-            self.out.push_str(&" ".repeat(depth * INDENT));
-            self.out.push_str(part);
-            self.out.push('\n');
+impl<'a> Printer<'a> {
+    fn file(&mut self, file: &File) {
+        let one_liner = |item: &Item| matches!(item, Item::Robot(_) | Item::Start(_));
+        let mut previous: Option<&Item> = None;
+        for item in &file.items {
+            // `robot` and `start` stay together as the header; blocks stand apart.
+            if previous.is_some_and(|prev| !(one_liner(prev) && one_liner(item))) {
+                self.blank();
+            }
+            match item {
+                Item::Robot(path) => {
+                    // The span is the string's text; its closing quote follows.
+                    let quoted = Span { start: path.span.start, end: path.span.end + 1 };
+                    self.line(
+                        Anchor::statement(quoted, quoted),
+                        &format!("robot {}", string(path)),
+                    );
+                }
+                Item::Start(start) => {
+                    let span = match start {
+                        Start::Joints(q) => q.span,
+                        Start::State { span, .. } => *span,
+                    };
+                    self.line(Anchor::statement(span, span), &self::start(start));
+                }
+                Item::Scene(scene) => self.scene(scene),
+                Item::Settings(settings) => self.settings(settings),
+                Item::Task(task) => self.task(task),
+            }
+            previous = Some(item);
         }
+    }
+
+    /// The text, with the comments that come after the last line.
+    fn finish(mut self) -> String {
+        let placement = std::mem::take(&mut self.comments);
+        self.pending.extend(placement.end);
+        // Comments placed against a line that was not printed: there are
+        // none, as both passes print the same lines, but none is ever lost.
+        let mut unprinted: Vec<&Comment> =
+            placement.before.into_values().chain(placement.after.into_values()).flatten().collect();
+        unprinted.sort_by_key(|c| c.span.start);
+        self.pending.extend(unprinted);
+        self.own_lines(0);
+        self.out
+    }
+
+    /// Writes `text` as one line at `depth`.
+    fn write(&mut self, depth: usize, text: &str) {
+        self.out.push_str(&" ".repeat(depth * INDENT));
+        self.out.push_str(text);
+        self.out.push('\n');
+    }
+
+    /// Writes the pending comments, one a line, at `depth`.
+    fn own_lines(&mut self, depth: usize) {
+        for comment in std::mem::take(&mut self.pending) {
+            self.write(depth, &comment.text);
+        }
+    }
+
+    /// Records the line of `anchor`, about to be written, and writes the
+    /// comments due before it at `depth`.
+    fn comments_before(&mut self, anchor: Anchor, depth: usize) {
+        self.anchors.push(anchor);
+        let before = self.comments.before.remove(&anchor.start).unwrap_or_default();
+        self.pending.extend(before);
+        self.own_lines(depth);
+    }
+
+    /// Puts the first comment after the line of `anchor`, just written, at
+    /// its end if it followed code in the source; the others wait for the
+    /// next line, where a reread would place them too.
+    fn comments_after(&mut self, anchor: Anchor) {
+        let mut after = self.comments.after.remove(&anchor.start).unwrap_or_default().into_iter();
+        match after.next() {
+            Some(first) if !first.own_line => {
+                self.out.pop();
+                self.out.push(' ');
+                self.out.push_str(&first.text);
+                self.out.push('\n');
+            }
+            Some(first) => self.pending.push(first),
+            None => {}
+        }
+        self.pending.extend(after);
+    }
+
+    /// Writes one statement at the current depth, with its comments. A `\n`
+    /// inside `text` (see [`gap`]) continues the statement on a line
+    /// indented two levels more.
+    fn line(&mut self, anchor: Anchor, text: &str) {
+        self.comments_before(anchor, self.depth);
+        for (i, part) in text.split('\n').enumerate() {
+            self.write(if i == 0 { self.depth } else { self.depth + 2 }, part);
+        }
+        self.comments_after(anchor);
     }
 
     fn blank(&mut self) {
         self.out.push('\n');
     }
 
-    /// `head {`, the lines `body` writes, `}`; `head {}` when it writes none.
-    fn block(&mut self, head: &str, body: impl FnOnce(&mut Self)) {
+    /// `head {`, the lines `body` writes, `}`; `head {}` when nothing, not
+    /// even a comment, comes between the braces. The head's text starts at
+    /// `start`.
+    fn block(&mut self, head: &str, start: usize, braces: Span, body: impl FnOnce(&mut Self)) {
+        let open = Anchor::open(start, braces);
+        let close = Anchor::close(braces);
+        self.comments_before(open, self.depth);
         let mark = self.out.len();
-        self.line(&format!("{head} {{"));
-        let open = self.out.len();
+        let comment_after_brace = self.comments.after.contains_key(&open.start);
+        self.write(self.depth, &format!("{head} {{"));
+        self.comments_after(open);
+        let inside = self.out.len();
         self.depth += 1;
         body(self);
+        // Comments after the last node go inside the braces.
+        self.comments_before(close, self.depth);
         self.depth -= 1;
-        if self.out.len() == open {
+        if self.out.len() == inside && !comment_after_brace {
             self.out.truncate(mark);
-            self.line(&format!("{head} {{}}"));
+            self.write(self.depth, &format!("{head} {{}}"));
         } else {
-            self.line("}");
+            self.write(self.depth, "}");
         }
+        self.comments_after(close);
     }
 
     fn scene(&mut self, scene: &Scene) {
         let name_width = scene.obstacles.iter().map(|o| width(&o.name.text)).max().unwrap_or(0);
         let shape_width =
             scene.obstacles.iter().map(|o| width(shape_keyword(&o.shape))).max().unwrap_or(0);
-        self.block("scene", |p| {
+        self.block("scene", scene.span.start, scene.braces, |p| {
             for obstacle in &scene.obstacles {
-                p.line(&self::obstacle(obstacle, name_width, shape_width));
+                let anchor = Anchor::statement(obstacle.span, obstacle.span);
+                p.line(anchor, &self::obstacle(obstacle, name_width, shape_width));
             }
         });
     }
 
     fn settings(&mut self, settings: &Settings) {
-        self.block("settings", |p| {
-            for Setting { name, value, .. } in &settings.entries {
+        self.block("settings", settings.span.start, settings.braces, |p| {
+            for Setting { name, value, span } in &settings.entries {
                 let value = match value {
                     SettingValue::Quantity(q) => quantity(q),
                     SettingValue::Word(word) => word.text.clone(),
                 };
-                p.line(&format!("{} {value}", name.text));
+                p.line(Anchor::statement(*span, *span), &format!("{} {value}", name.text));
             }
         });
     }
 
+    /// A fact-list statement: `init`, `goal`, `pre`, `add` or `del`.
+    fn facts(&mut self, keyword: &str, facts: &Facts) {
+        self.line(
+            Anchor::statement(facts.span, facts.span),
+            &format!("{keyword} {}", self::facts(facts)),
+        );
+    }
+
     fn task(&mut self, task: &Task) {
-        self.block(&format!("task {}", task.name.text), |p| {
+        self.block(&format!("task {}", task.name.text), task.span.start, task.braces, |p| {
             for facts in &task.init {
-                p.line(&format!("init {}", self::facts(facts)));
+                p.facts("init", facts);
             }
             for facts in &task.goal {
-                p.line(&format!("goal {}", self::facts(facts)));
+                p.facts("goal", facts);
             }
             for (i, action) in task.actions.iter().enumerate() {
                 if i > 0 || !task.init.is_empty() || !task.goal.is_empty() {
@@ -129,24 +319,33 @@ impl Printer {
         if matches!(action.body, ActionBody::Explicit { .. }) {
             head.push_str(" explicit");
         }
-        self.block(&head, |p| {
+        self.block(&head, action.span.start, action.braces, |p| {
             for (keyword, list) in
                 [("pre", &action.pre), ("add", &action.add), ("del", &action.del)]
             {
                 for facts in list {
-                    p.line(&format!("{keyword} {}", self::facts(facts)));
+                    p.facts(keyword, facts);
                 }
             }
             match &action.body {
                 ActionBody::Constraints { goals, paths, durations } => {
                     for g in goals {
-                        p.line(&goal(g));
+                        let last = g.terms.last().map_or(g.span, |t| t.span);
+                        p.line(Anchor::statement(g.span, last), &goal(g));
                     }
                     for path in paths {
-                        p.line(&self::path(path));
+                        let last = match (&path.hardness, path.items.last()) {
+                            (Some(hardness), _) => hardness.span,
+                            (None, Some(item)) => item.span,
+                            (None, None) => path.span,
+                        };
+                        p.line(Anchor::statement(path.span, last), &self::path(path));
                     }
                     for d in durations {
-                        p.line(&format!("duration {}", quantity(d)));
+                        p.line(
+                            Anchor::statement(d.span, d.span),
+                            &format!("duration {}", quantity(d)),
+                        );
                     }
                     p.solvers(action);
                 }
@@ -155,7 +354,8 @@ impl Printer {
                     p.solvers(action);
                     for (i, s) in segments.iter().enumerate() {
                         let joint = if i == 0 { "" } else { "+Tr " };
-                        p.line(&format!("{joint}{}", segment(s)));
+                        let anchor = Anchor::statement(s.span, s.braces);
+                        p.line(anchor, &format!("{joint}{}", segment(s)));
                     }
                 }
             }
@@ -164,7 +364,10 @@ impl Printer {
 
     fn solvers(&mut self, action: &Action) {
         for solver in &action.solver {
-            self.line(&format!("solver {}", solver.text));
+            self.line(
+                Anchor::statement(solver.span, solver.span),
+                &format!("solver {}", solver.text),
+            );
         }
     }
 }
@@ -460,7 +663,7 @@ task push_box_a_aside {
 }
 "#;
 
-    const EVERYTHING_CANONICAL: &str = r#"robot "../../robots/coman_right_arm.urdf"
+    const EVERYTHING_CANONICAL: &str = r#"robot "../../robots/coman_right_arm.urdf" # path relative to this file
 start [0, -20, 0, -60, 0, 10, 0] deg
 
 scene {
@@ -515,15 +718,211 @@ task push_box_a_aside {
 }
 "#;
 
-    /// Checks the two laws on `text` and returns its canonical form.
+    /// [`EVERYTHING`] with comments of every kind in every kind of place.
+    const COMMENTED: &str = r#"# header comment
+// second header line
+
+robot "../../robots/coman_right_arm.urdf"   # path relative to this file
+start [0, -20, 0, -60, 0, 10, 0] deg   // joints
+
+# the obstacles
+scene {   # opening
+  table = box      at [0.45, 0, -0.30]  size [0.40, 0.80, 0.04]   # the table
+  # a box on it
+  box_a = box      at [0.42, 0.06, -0.23] size [0.08, 0.08, 0.10]
+  bar   = capsule  from [0.3, -0.3, 0.1]
+                   to [0.3, 0.3, 0.1]   # inside an obstacle
+                   radius 0.02
+  post  = cylinder at [0.37, 0.05, -0.5] radius 0.03 height 1.0
+  ball  = sphere   at [0.3, 0.1, 0.0] radius 5 cm
+  # after the last obstacle
+}   # closing
+
+settings { rate 100 Hz  solver auto  # two on a line
+  seed 7  transition 20 %  frame base
+  // end of settings
+}
+
+task push_box_a_aside {   # the task
+  init { holding, box_b_near_a }
+  # the goal facts
+  goal { box_a_aside,   # first
+         hand_empty }
+
+  # drops
+  action drop "Drop the # things // in the hand" {
+    pre { holding } add { hand_empty } del { holding }   # three on a line
+    goal Pw Ow = ([0.25, -0.28, -0.05], rpy(180, 0, 90) deg)   # first goal
+         ≻ Os = axes(r: [0, 0, -1], l: [0, 1, 0])                 # second goal
+    duration 2 s
+  }   # end of drop
+  action retract {
+    pre { hand_empty, box_b_near_a } add { box_b_moved } del { box_b_near_a }
+    goal Pw Ow = ([0.15, -0.25, 0.05], rpy(180, 0, 90) deg)
+    path Os about z,   # about z
+         # then
+         θe hold : hard
+    # end of retract
+  }
+  +Se   # sequential
+  action push {
+    pre { box_b_moved } add { box_a_aside }
+    path Pw line [0, 1, 0] 0.12 m, Ow hold, θsw hold
+    solver qp   # the solver
+  }
+  action type_vii   # header
+  explicit {
+    // before the first segment
+    segment 1.2 s {   # first segment
+      Os.path(about r, 24.7 deg)
+      # parallel
+      +Pa (θe Ow).goal(100 deg, rpy(-15.5, -11.5, -104.6) deg) }
+    +Tr segment 1.0 s { (Pw Ow).goal([0.27, -0.10, 0.05], axes(f: [1,0,0], p: [0,1,0])) +Pa θsw.hold }
+    # third
+    +Tr segment 0.8 s { (Pw Ow).hold +Pa θsw.goal(63.2 deg) }
+    +Tr segment { (Pw Ow sw).hold -Pa sw +Pa sw.path(by 10 deg) }   // last
+  }
+  action empty { # nothing yet
+  }
+  action empty_too {
+    // to do
+  }
+}
+# the end
+"#;
+
+    const COMMENTED_CANONICAL: &str = r#"# header comment
+// second header line
+robot "../../robots/coman_right_arm.urdf" # path relative to this file
+start [0, -20, 0, -60, 0, 10, 0] deg // joints
+
+# the obstacles
+scene { # opening
+  table = box      at [0.45, 0, -0.3] size [0.4, 0.8, 0.04] # the table
+  # a box on it
+  box_a = box      at [0.42, 0.06, -0.23] size [0.08, 0.08, 0.1]
+  bar   = capsule  from [0.3, -0.3, 0.1] to [0.3, 0.3, 0.1] radius 0.02 # inside an obstacle
+  post  = cylinder at [0.37, 0.05, -0.5] radius 0.03 height 1
+  ball  = sphere   at [0.3, 0.1, 0] radius 5 cm
+  # after the last obstacle
+} # closing
+
+settings {
+  rate 100 Hz
+  solver auto # two on a line
+  seed 7
+  transition 20 %
+  frame base
+  // end of settings
+}
+
+task push_box_a_aside { # the task
+  init { holding, box_b_near_a }
+  # the goal facts
+  goal { box_a_aside, hand_empty } # first
+
+  # drops
+  action drop "Drop the # things // in the hand" {
+    pre { holding }
+    add { hand_empty }
+    del { holding } # three on a line
+    goal Pw Ow = ([0.25, -0.28, -0.05], rpy(180, 0, 90) deg) > Os = axes(r: [0, 0, -1], l: [0, 1, 0]) # first goal
+    # second goal
+    duration 2 s
+  } # end of drop
+
+  action retract {
+    pre { hand_empty, box_b_near_a }
+    add { box_b_moved }
+    del { box_b_near_a }
+    goal Pw Ow = ([0.15, -0.25, 0.05], rpy(180, 0, 90) deg)
+    path Os about z, θe hold : hard # about z
+    # then
+    # end of retract
+  }
+
+  action push { # sequential
+    pre { box_b_moved }
+    add { box_a_aside }
+    path Pw line [0, 1, 0] 0.12 m, Ow hold, θsw hold
+    solver qp # the solver
+  }
+
+  action type_vii explicit { # header
+    // before the first segment
+    segment 1.2 s { Os.path(about r, 24.7 deg) +Pa (θe Ow).goal(100 deg, rpy(-15.5, -11.5, -104.6) deg) } # first segment
+    # parallel
+    +Tr segment 1 s { (Pw Ow).goal([0.27, -0.1, 0.05], axes(f: [1, 0, 0], p: [0, 1, 0])) +Pa θsw.hold }
+    # third
+    +Tr segment 0.8 s { (Pw Ow).hold +Pa θsw.goal(63.2 deg) }
+    +Tr segment { (Pw Ow sw).hold -Pa sw +Pa sw.path(by 10 deg) } // last
+  }
+
+  action empty { # nothing yet
+  }
+
+  action empty_too {
+    // to do
+  }
+}
+# the end
+"#;
+
+    /// Checks the laws on `text` and returns its canonical form: the printed
+    /// text reads back to the same items and comments and prints the same.
+    /// Comments keep their order unless statements they go with are put in
+    /// canonical order.
     fn canonical(text: &str) -> String {
         let tree = parse_ast(text, None).unwrap_or_else(|d| panic!("input parses:\n{d}"));
         let printed = format(&tree);
         let reparsed = parse_ast(&printed, None)
             .unwrap_or_else(|d| panic!("canonical form parses:\n{d}\n--- printed:\n{printed}"));
-        assert_eq!(reparsed, tree, "same tree after printing:\n{printed}");
+        if comment_order_kept(&tree) {
+            assert_eq!(reparsed, tree, "same tree after printing:\n{printed}");
+        } else {
+            assert_eq!(reparsed.items, tree.items, "same items after printing:\n{printed}");
+            let texts = |file: &File| {
+                let mut texts: Vec<String> = file.comments.iter().map(|c| c.text.clone()).collect();
+                texts.sort();
+                texts
+            };
+            assert_eq!(texts(&reparsed), texts(&tree), "same comments after printing:\n{printed}");
+        }
         assert_eq!(format(&reparsed), printed, "idempotent");
         printed
+    }
+
+    /// Whether printing keeps the comments in order: no task or action that
+    /// has its statements out of print order holds a comment.
+    fn comment_order_kept(file: &File) -> bool {
+        let increasing = |spans: Vec<Span>| spans.windows(2).all(|w| w[0].start < w[1].start);
+        let facts = |lists: &[&Vec<Facts>]| -> Vec<Span> {
+            lists.iter().flat_map(|list| list.iter().map(|f| f.span)).collect()
+        };
+        let uncommented = |extent: Span| {
+            !file.comments.iter().any(|c| (extent.start..extent.end).contains(&c.span.start))
+        };
+        file.items.iter().all(|item| {
+            let Item::Task(task) = item else { return true };
+            let actions_kept = task.actions.iter().all(|action| {
+                let mut spans = facts(&[&action.pre, &action.add, &action.del]);
+                if let ActionBody::Constraints { goals, paths, durations } = &action.body {
+                    spans.extend(goals.iter().map(|g| g.span));
+                    spans.extend(paths.iter().map(|p| p.span));
+                    spans.extend(durations.iter().map(|d| d.span));
+                }
+                spans.extend(action.solver.iter().map(|s| s.span));
+                increasing(spans) || uncommented(action.braces)
+            });
+            actions_kept
+                && (increasing(facts(&[&task.init, &task.goal])) || uncommented(task.braces))
+        })
+    }
+
+    /// The comment texts of `text`, in order.
+    fn comment_texts(text: &str) -> Vec<String> {
+        let tree = parse_ast(text, None).unwrap_or_else(|d| panic!("input parses:\n{d}"));
+        tree.comments.into_iter().map(|c| c.text).collect()
     }
 
     #[test]
@@ -537,11 +936,269 @@ task push_box_a_aside {
     }
 
     #[test]
-    fn comments_and_layout_go() {
-        let text = "// header\nrobot   \"a.urdf\" # trailing\n\n\n  start [ 0,0 , 0,0,0,0,0 ]rad\n";
-        assert_eq!(canonical(text), "robot \"a.urdf\"\nstart [0, 0, 0, 0, 0, 0, 0] rad\n");
+    fn layout_goes_comments_stay() {
+        let text =
+            "// header\nrobot   \"a.urdf\" # trailing  \r\n\n\n  start [ 0,0 , 0,0,0,0,0 ]rad\n";
+        assert_eq!(
+            canonical(text),
+            "// header\nrobot \"a.urdf\" # trailing\nstart [0, 0, 0, 0, 0, 0, 0] rad\n"
+        );
         assert_eq!(canonical(""), "");
-        assert_eq!(canonical("# only a comment\n"), "");
+        assert_eq!(canonical("# only a comment\n"), "# only a comment\n");
+        assert_eq!(canonical("\u{FEFF}  # one\n\n\n// two"), "# one\n// two\n");
+    }
+
+    #[test]
+    fn comments_everywhere_round_trip() {
+        assert_eq!(canonical(COMMENTED), COMMENTED_CANONICAL);
+        assert_eq!(canonical(COMMENTED_CANONICAL), COMMENTED_CANONICAL);
+    }
+
+    #[test]
+    fn own_line_comments_go_before_the_next_node() {
+        let text = "# robot\nrobot \"a.urdf\"\n\n\n# start\nstart [0, 0, 0, 0, 0, 0, 0]
+# scene, after the blank line
+scene { # obstacles
+# a
+a = sphere at [0, 0, 0] radius 1 }
+task t {
+# init
+init { x } goal { y }
+# first action
+action a { goal Pw = [0, 0, 0]
+# path, then duration
+path Ow hold duration 1 s }
+# second action
+action b { goal θsw = 1 } }";
+        assert_eq!(
+            canonical(text),
+            "# robot
+robot \"a.urdf\"
+# start
+start [0, 0, 0, 0, 0, 0, 0]
+
+# scene, after the blank line
+scene { # obstacles
+  # a
+  a = sphere at [0, 0, 0] radius 1
+}
+
+task t {
+  # init
+  init { x }
+  goal { y }
+
+  # first action
+  action a {
+    goal Pw = [0, 0, 0]
+    # path, then duration
+    path Ow hold
+    duration 1 s
+  }
+
+  # second action
+  action b {
+    goal θsw = 1
+  }
+}
+"
+        );
+    }
+
+    #[test]
+    fn trailing_comments_follow_their_line() {
+        let text = "robot \"a.urdf\" // robot
+scene { a = box at [0, 0, 0] size [1, 1, 1] # box
+  b = sphere at [1, 1, 1]   # a comment inside a node
+    radius 1 }   # scene
+task t { action a { goal Pw = [0, 0, 0] # goal
+  path Ow hold,   # Ow
+    θsw hold      # θsw
+} # a
++Se  # after +Se
+action b { goal Ow = rpy(0, 0, 0) } } # t";
+        assert_eq!(
+            canonical(text),
+            "robot \"a.urdf\" // robot
+
+scene {
+  a = box    at [0, 0, 0] size [1, 1, 1] # box
+  b = sphere at [1, 1, 1] radius 1 # a comment inside a node
+} # scene
+
+task t {
+  action a {
+    goal Pw = [0, 0, 0] # goal
+    path Ow hold, θsw hold # Ow
+    # θsw
+  } # a
+
+  action b { # after +Se
+    goal Ow = rpy(0, 0, 0)
+  }
+} # t
+"
+        );
+    }
+
+    #[test]
+    fn trailing_comment_after_a_statement_over_several_lines() {
+        // An unknown unit ends its line, so the statement takes two.
+        let text = "scene { post = cylinder at [0, 0, 0] radius 3 cmm # post\n height 1 m }";
+        assert_eq!(
+            canonical(text),
+            "scene {\n  post = cylinder at [0, 0, 0] radius 3 cmm\n      height 1 m # post\n}\n"
+        );
+    }
+
+    #[test]
+    fn comments_at_the_end_of_blocks_and_of_the_file() {
+        let text = "scene {
+  a = sphere at [0, 0, 0] radius 1
+  # end of scene
+}
+settings {
+  # nothing set
+}
+task t {
+  action a {
+  }
+  action b explicit {
+    segment { Pw.hold }
+    # end of b
+  }
+  # end of t
+}
+// end of file
+# really";
+        assert_eq!(
+            canonical(text),
+            "scene {
+  a = sphere at [0, 0, 0] radius 1
+  # end of scene
+}
+
+settings {
+  # nothing set
+}
+
+task t {
+  action a {}
+
+  action b explicit {
+    segment { Pw.hold }
+    # end of b
+  }
+  # end of t
+}
+// end of file
+# really
+"
+        );
+        // A comment keeps an empty block open, whether on the brace's line
+        // or its own.
+        assert_eq!(canonical("scene { # none yet\n}"), "scene { # none yet\n}\n");
+        assert_eq!(canonical("scene {} # none yet"), "scene {} # none yet\n");
+        assert_eq!(
+            canonical("task t { action a { // to do\n // later\n} }"),
+            "task t {
+  action a { // to do
+    // later
+  }
+}
+"
+        );
+    }
+
+    #[test]
+    fn comments_inside_settings_segments_and_explicit_actions() {
+        let text = "settings { rate 100 Hz # fast
+  # seeded
+  seed 7 }
+task t { action a # the action
+  explicit { # segments follow
+  pre { x,
+        # y is not needed
+        z }
+  solver qp // the solver
+  # first segment
+  segment 1 s {
+    # inside, before the first primitive
+    Pw.hold   # hold
+    +Pa Ow.hold
+  }
+  +Tr segment { (Pw Ow θsw).hold } } }";
+        assert_eq!(
+            canonical(text),
+            "settings {
+  rate 100 Hz # fast
+  # seeded
+  seed 7
+}
+
+task t {
+  action a explicit { # the action
+    # segments follow
+    pre { x, z }
+    # y is not needed
+    solver qp // the solver
+    # first segment
+    segment 1 s { Pw.hold +Pa Ow.hold }
+    # inside, before the first primitive
+    # hold
+    +Tr segment { (Pw Ow θsw).hold }
+  }
+}
+"
+        );
+    }
+
+    #[test]
+    fn both_styles_and_strings() {
+        let text =
+            "robot \"a#b//c.urdf\" #a // b\n//c # d\ntask t { action a \"# not // a comment\" {} }";
+        let tree = parse_ast(text, None).expect("parses");
+        let comments: Vec<(&str, bool)> =
+            tree.comments.iter().map(|c| (c.text.as_str(), c.own_line)).collect();
+        assert_eq!(comments, [("#a // b", false), ("//c # d", true)]);
+        let Item::Robot(path) = &tree.items[0] else { panic!("robot") };
+        assert_eq!(path.text, "a#b//c.urdf");
+        assert_eq!(
+            canonical(text),
+            "robot \"a#b//c.urdf\" #a // b\n\n//c # d\ntask t {\n  action a \"# not // a comment\" {}\n}\n"
+        );
+        // One slash is not a comment, and does not parse.
+        assert!(parse_ast("robot \"a.urdf\" / no", None).is_err());
+    }
+
+    #[test]
+    fn comments_move_with_statements_put_in_order() {
+        let text = "task t { goal { y } # the goal
+  init { x } # the start
+  action a {
+    solver qp # why qp
+    path Pw hold # the path
+    del { x } # the del
+  } }";
+        let printed = canonical(text);
+        assert_eq!(
+            printed,
+            "task t {
+  init { x } # the start
+  goal { y } # the goal
+
+  action a {
+    del { x } # the del
+    path Pw hold # the path
+    solver qp # why qp
+  }
+}
+"
+        );
+        assert_eq!(
+            comment_texts(&printed),
+            ["# the start", "# the goal", "# the del", "# the path", "# why qp"]
+        );
     }
 
     #[test]
@@ -592,35 +1249,90 @@ action b explicit { segment 2 s { (Pw Ow).path(line [0, 1, 0] 0.1) +Pa θsw.path
         assert!(printed.contains("(Pw Ow).path(line [0, 1, 0], 0.1) +Pa θsw.path(about l)"));
     }
 
-    /// Every variant of [`EVERYTHING`] with one word left out, or with one
-    /// line break turned into a space, that still parses keeps the laws.
+    /// Every variant of [`EVERYTHING`] and [`COMMENTED`] with one word left
+    /// out, or with one line break turned into a space, that still parses
+    /// keeps the laws.
     #[test]
     fn near_variants_round_trip() {
-        let words: Vec<&str> = EVERYTHING.split(' ').collect();
-        let mut parsed = 0;
-        for i in 0..words.len() {
-            let mut fewer = words.clone();
-            fewer.remove(i);
-            let text = fewer.join(" ");
-            if parse_ast(&text, None).is_ok() {
-                canonical(&text);
-                parsed += 1;
+        for source in [EVERYTHING, COMMENTED] {
+            let words: Vec<&str> = source.split(' ').collect();
+            let mut parsed = 0;
+            for i in 0..words.len() {
+                let mut fewer = words.clone();
+                fewer.remove(i);
+                let text = fewer.join(" ");
+                if parse_ast(&text, None).is_ok() {
+                    canonical(&text);
+                    parsed += 1;
+                }
             }
-        }
-        for (i, _) in EVERYTHING.match_indices('\n') {
-            let text = format!("{} {}", &EVERYTHING[..i], &EVERYTHING[i + 1..]);
-            if parse_ast(&text, None).is_ok() {
-                canonical(&text);
-                parsed += 1;
+            for (i, _) in source.match_indices('\n') {
+                let text = format!("{} {}", &source[..i], &source[i + 1..]);
+                if parse_ast(&text, None).is_ok() {
+                    canonical(&text);
+                    parsed += 1;
+                }
             }
+            assert!(parsed > 50, "only {parsed} variants parse");
         }
-        assert!(parsed > 50, "only {parsed} variants parse");
     }
 
+    /// A comment put in place of any space or line break of [`EVERYTHING`],
+    /// [`COMMENTED`] or [`MISSPELT`], ending a line or on a line of its own;
+    /// one at every line break at once; or several at random places: each
+    /// variant that still parses keeps the laws and the comment.
     #[test]
-    fn misspelt_units_survive() {
-        // Unknown unit words are units only at the end of a line.
-        let text = "start Pw [0.2, -0.1, -0.2] mx
+    fn added_comments_round_trip() {
+        let comment = |i: usize, own_line: bool| {
+            if own_line { format!("\n  // added {i}\n") } else { format!(" # added {i}\n") }
+        };
+        let mut state: u64 = 0x2545_F491_4F6C_DD1D;
+        let mut random = move |below: usize| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            usize::try_from(state % below as u64).expect("below a usize")
+        };
+        for source in [EVERYTHING, COMMENTED, MISSPELT] {
+            let spaces: Vec<(usize, usize)> =
+                source.match_indices([' ', '\n']).map(|(i, s)| (i, s.len())).collect();
+            let mut parsed = 0;
+            for &(i, len) in &spaces {
+                for own_line in [false, true] {
+                    let text =
+                        format!("{}{}{}", &source[..i], comment(i, own_line), &source[i + len..]);
+                    if parse_ast(&text, None).is_err() {
+                        continue;
+                    }
+                    let printed = canonical(&text);
+                    // After a comment, a trailing one only lengthens it.
+                    let kept = comment_texts(&printed);
+                    assert!(kept.iter().any(|t| t.ends_with(&format!("added {i}"))), "{printed}");
+                    parsed += 1;
+                }
+            }
+            assert!(parsed > 100, "only {parsed} variants parse");
+            for style in ["  # everywhere", "\n# everywhere"] {
+                canonical(&source.replace('\n', &format!("{style}\n")));
+            }
+            for _ in 0..200 {
+                let mut text = source.to_owned();
+                let mut picked: Vec<(usize, usize)> =
+                    (0..2 + random(3)).map(|_| spaces[random(spaces.len())]).collect();
+                picked.sort_unstable();
+                picked.dedup();
+                for &(i, len) in picked.iter().rev() {
+                    text.replace_range(i..i + len, &comment(i, random(2) == 0));
+                }
+                if parse_ast(&text, None).is_ok() {
+                    canonical(&text);
+                }
+            }
+        }
+    }
+
+    /// Unknown unit words, which are units only at the end of a line.
+    const MISSPELT: &str = "start Pw [0.2, -0.1, -0.2] mx
   Ow rpy(0, 90, 0) dgr
   sw 30 deg
 scene { post = cylinder at [0, 0, 0] mx
@@ -630,7 +1342,10 @@ task t { action a { path Pw line [0, 1, 0] mx
   2 cm }
   action b explicit { segment 2 sec
   { Pw.hold } } }";
-        let printed = canonical(text);
+
+    #[test]
+    fn misspelt_units_survive() {
+        let printed = canonical(MISSPELT);
         assert!(printed.contains("start Pw [0.2, -0.1, -0.2] mx\n    Ow rpy(0, 90, 0) dgr\n"));
     }
 

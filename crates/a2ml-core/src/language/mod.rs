@@ -2,9 +2,9 @@
 //! [`Task`], with located diagnostics.
 //!
 //! Entry points: [`parse`] (text), [`load`] (a file), [`parse_ast`] (the
-//! syntax tree alone), [`format()`] (a syntax tree back to canonical text;
-//! comments are not in the tree and are dropped). Units become SI at
-//! validation; every syntax node keeps the byte span of its text.
+//! syntax tree alone, comments included), [`format()`] (a syntax tree back
+//! to canonical text, comments kept). Units become SI at validation; every
+//! syntax node keeps the byte span of its text.
 
 pub mod ast;
 mod diagnostic;

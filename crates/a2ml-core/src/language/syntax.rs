@@ -23,7 +23,76 @@ pub fn parse_file(text: &str) -> Result<ast::File, Diagnostic> {
     let file = pairs.next().ok_or_else(|| Diagnostic::new(Span::default(), "empty input"))?;
     Ok(ast::File {
         items: file.into_inner().filter(|p| p.as_rule() != Rule::EOI).map(item).collect(),
+        comments: comments(text),
     })
+}
+
+/// The comments of a text that parses, in order.
+///
+/// A scan of the text rather than a non-silent `COMMENT` rule: pest would
+/// put such comments among the inner pairs of whichever rule they fall in,
+/// and every `inner.next()` below would have to step over them. The scan is
+/// exact for a text that parses: outside comments, `#` and `/` occur only
+/// inside strings, and a string runs from `"` to the next `"` on its line.
+fn comments(text: &str) -> Vec<ast::Comment> {
+    let mut found = Vec::new();
+    let mut code_on_line = false;
+    let mut code_end = 0;
+    let mut chars = text.char_indices().peekable();
+    while let Some((i, c)) = chars.next() {
+        let starts_comment =
+            c == '#' || (c == '/' && chars.peek().is_some_and(|&(_, next)| next == '/'));
+        if starts_comment {
+            let line_end = text[i..].find('\n').map_or(text.len(), |n| i + n);
+            let comment = text[i..line_end].trim_end_matches(BLANK);
+            found.push(ast::Comment {
+                text: comment.to_owned(),
+                own_line: !code_on_line,
+                code_before: code_end,
+                span: Span { start: i, end: i + comment.len() },
+            });
+            while chars.next_if(|&(j, _)| j < line_end).is_some() {}
+            continue;
+        }
+        match c {
+            '\n' => code_on_line = false,
+            c if BLANK.contains(&c) => {}
+            '"' => {
+                code_on_line = true;
+                code_end = i + 1;
+                while let Some((j, c)) = chars.next_if(|&(_, c)| c != '\n') {
+                    code_end = j + c.len_utf8();
+                    if c == '"' {
+                        break;
+                    }
+                }
+            }
+            _ => {
+                code_on_line = true;
+                code_end = i + c.len_utf8();
+            }
+        }
+    }
+    found
+}
+
+/// The grammar's `WHITESPACE` but the line break.
+const BLANK: [char; 4] = [' ', '\t', '\r', '\u{FEFF}'];
+
+/// The braces of a block: from the `{` that comes next after `from`, past
+/// whitespace and comments, to the end of `node`, which is its `}`.
+fn braces(node: &Node<'_>, from: usize) -> Span {
+    let text = node.as_span().get_input();
+    let mut start = from;
+    loop {
+        let rest = &text[start..];
+        let code = rest.trim_start_matches(|c| c == '\n' || BLANK.contains(&c));
+        start += rest.len() - code.len();
+        if !code.starts_with(['#', '/']) {
+            return Span { start, end: node.as_span().end() };
+        }
+        start += code.find('\n').unwrap_or(code.len());
+    }
 }
 
 /// What a rule is called in messages.
@@ -223,16 +292,20 @@ fn item(node: Node<'_>) -> ast::Item {
         Rule::start => ast::Item::Start(start(first_inner(node))),
         Rule::scene => {
             let sp = span(&node);
+            let braces = braces(&node, sp.start + "scene".len());
             ast::Item::Scene(ast::Scene {
                 obstacles: node.into_inner().map(obstacle).collect(),
                 span: sp,
+                braces,
             })
         }
         Rule::settings => {
             let sp = span(&node);
+            let braces = braces(&node, sp.start + "settings".len());
             ast::Item::Settings(ast::Settings {
                 entries: node.into_inner().map(setting).collect(),
                 span: sp,
+                braces,
             })
         }
         _ => ast::Item::Task(task(node)),
@@ -293,10 +366,11 @@ fn setting(node: Node<'_>) -> ast::Setting {
 }
 
 fn task(node: Node<'_>) -> ast::Task {
-    let mut inner = node.into_inner();
+    let mut inner = node.clone().into_inner();
     let task_name = inner.next().map(name).expect("task has a name");
     let mut out = ast::Task {
         span: task_name.span,
+        braces: braces(&node, task_name.span.end),
         name: task_name,
         init: Vec::new(),
         goal: Vec::new(),
@@ -318,6 +392,7 @@ fn action(node: Node<'_>) -> ast::Action {
     let action_name = inner.next().map(name).expect("action has a name");
     let mut out = ast::Action {
         span: action_name.span,
+        braces: Span::default(),
         name: action_name,
         description: None,
         pre: Vec::new(),
@@ -334,6 +409,7 @@ fn action(node: Node<'_>) -> ast::Action {
         match n.as_rule() {
             Rule::string => out.description = Some(string(n)),
             Rule::constraint_body => {
+                out.braces = span(&n);
                 let (mut goals, mut paths, mut durations) = (Vec::new(), Vec::new(), Vec::new());
                 for s in n.into_inner() {
                     match s.as_rule() {
@@ -346,6 +422,7 @@ fn action(node: Node<'_>) -> ast::Action {
                 out.body = ast::ActionBody::Constraints { goals, paths, durations };
             }
             _ => {
+                out.braces = braces(&n, span(&n).start + "explicit".len());
                 let mut segments = Vec::new();
                 for s in n.into_inner() {
                     match s.as_rule() {
@@ -427,7 +504,7 @@ fn segment(node: Node<'_>) -> ast::Segment {
     let mut duration = None;
     let mut primitives = Vec::new();
     let mut combine = ast::Combine::Add;
-    for n in node.into_inner() {
+    for n in node.clone().into_inner() {
         match n.as_rule() {
             Rule::quantity => duration = Some(quantity(n)),
             Rule::pa => {
@@ -436,11 +513,9 @@ fn segment(node: Node<'_>) -> ast::Segment {
             _ => primitives.push((combine, primitive(n))),
         }
     }
-    ast::Segment {
-        duration,
-        primitives,
-        span: Span { start: sp.start, end: sp.start + "segment".len() },
-    }
+    let keyword = Span { start: sp.start, end: sp.start + "segment".len() };
+    let before_brace = duration.as_ref().map_or(keyword.end, |d| d.span.end);
+    ast::Segment { duration, primitives, span: keyword, braces: braces(&node, before_brace) }
 }
 
 fn primitive(node: Node<'_>) -> ast::Primitive {
@@ -453,4 +528,41 @@ fn primitive(node: Node<'_>) -> ast::Primitive {
         _ => ast::PrimitiveConstraint::Hold,
     });
     ast::Primitive { variables: vars, constraint, span: sp }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn comments_are_found_outside_strings() {
+        let text = "\u{FEFF}# one\r\nrobot \"a#b//c\" // two  \n  // three\nstart [0]#four";
+        let found = comments(text);
+        let summary: Vec<(&str, bool, usize)> =
+            found.iter().map(|c| (c.text.as_str(), c.own_line, c.code_before)).collect();
+        let after_string = text.find("c\"").expect("string") + 2;
+        let after_vector = text.find("[0]").expect("vector") + 3;
+        assert_eq!(
+            summary,
+            [
+                ("# one", true, 0),
+                ("// two", false, after_string),
+                ("// three", true, after_string),
+                ("#four", false, after_vector),
+            ]
+        );
+        assert_eq!(&text[found[3].span.start..found[3].span.end], "#four");
+        assert!(comments("robot \"x\" / 2").is_empty());
+    }
+
+    #[test]
+    fn braces_skip_comments_before_the_opening_one() {
+        let text = "task t # a { b\n  // {\n  { action a { goal Pw = [0, 0, 0] } }";
+        let file = parse_file(text).expect("parses");
+        let ast::Item::Task(task) = &file.items[0] else { panic!("a task") };
+        assert_eq!(task.braces.start, text.find("{ action").expect("brace"));
+        assert_eq!(task.braces.end, text.len());
+        assert_eq!(task.actions[0].braces.start, text.find("{ goal").expect("brace"));
+        assert_eq!(task.actions[0].braces.end, text.len() - 2);
+    }
 }
