@@ -29,7 +29,7 @@ type Dict<'py> = Bound<'py, PyDict>;
 /// which it pickles.
 #[pyclass(frozen, module = "a2ml", name = "Task")]
 pub(crate) struct PyTask {
-    task: language::Task,
+    pub(crate) task: language::Task,
     source: String,
     path: Option<PathBuf>,
 }
@@ -177,11 +177,11 @@ fn variable_name(v: Variable) -> &'static str {
     }
 }
 
-fn variable_names(vs: &[Variable]) -> Vec<&'static str> {
+pub(crate) fn variable_names(vs: &[Variable]) -> Vec<&'static str> {
     vs.iter().copied().map(variable_name).collect()
 }
 
-fn space_name(s: Space) -> &'static str {
+pub(crate) fn space_name(s: Space) -> &'static str {
     match s {
         Space::Cpsa => "cpsa",
         Space::Hat => "hat",
@@ -336,7 +336,7 @@ fn path_constraint<'py>(py: Python<'py>, pc: &PathConstraint) -> PyResult<Dict<'
 
 /// `{"variables": [...], "kind": "goal" | "path" | "hold"}` plus `goal`
 /// (`{variable: value}`) or `feature`.
-fn primitive<'py>(py: Python<'py>, p: &Primitive) -> PyResult<Dict<'py>> {
+pub(crate) fn primitive<'py>(py: Python<'py>, p: &Primitive) -> PyResult<Dict<'py>> {
     let d = PyDict::new(py);
     d.set_item("variables", variable_names(&p.variables))?;
     match &p.constraint {

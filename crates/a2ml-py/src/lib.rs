@@ -2,8 +2,10 @@
 //! `a2ml._a2ml`. Thin by design: every method converts its inputs, calls
 //! the core and converts the result; all kinematics lives in the core.
 //! Arrays cross as float64 numpy arrays; frames and units as in DESIGN.md §2.
-//! The task language is in [`language`]; exceptions and their mapping here.
+//! The task language is in [`language`], the decomposition in
+//! [`decompose`]; exceptions and their mapping here.
 
+mod decompose;
 mod language;
 
 use std::path::{Path, PathBuf};
@@ -48,6 +50,12 @@ create_exception!(
     A2mlError,
     "Numerical IK failed, or the arm has no closed form."
 );
+create_exception!(
+    a2ml,
+    DecomposeError,
+    A2mlError,
+    "The task cannot be decomposed into actions and movement segments."
+);
 
 /// A core error on its way to Python (polars' newtype pattern): the one
 /// place that decides which exception class each error kind becomes.
@@ -68,6 +76,12 @@ impl From<KinematicsError> for CoreError {
 impl From<LanguageError> for CoreError {
     fn from(e: LanguageError) -> Self {
         Self(e.into())
+    }
+}
+
+impl From<a2ml_core::Error> for CoreError {
+    fn from(e: a2ml_core::Error) -> Self {
+        Self(e)
     }
 }
 
@@ -94,6 +108,9 @@ impl From<CoreError> for PyErr {
                 }
                 KinematicsError::NonFinite { .. } => PyValueError::new_err(message),
             },
+            Error::Decompose(_) => DecomposeError::new_err(message),
+            // No profile API in Python yet; the base class until there is.
+            Error::Profile(_) => A2mlError::new_err(message),
         }
     }
 }
@@ -111,8 +128,7 @@ fn parse_error(py: Python<'_>, d: &Diagnostics) -> PyErr {
         })
         .collect();
     // The core never reports an empty list; if it did, point at the start.
-    let (line, column, message) =
-        errors.first().cloned().unwrap_or_else(|| (1, 1, d.to_string()));
+    let (line, column, message) = errors.first().cloned().unwrap_or_else(|| (1, 1, d.to_string()));
     let err = ParseError::new_err(d.to_string());
     let value = err.value(py);
     let set = || -> PyResult<()> {
@@ -255,8 +271,8 @@ fn to_solutions<'py>(
 ///
 /// Pickles as its URDF text (kept by the core model) and the chain options.
 #[pyclass(frozen, module = "a2ml", name = "Robot")]
-struct PyRobot {
-    robot: a2ml_core::Robot,
+pub(crate) struct PyRobot {
+    pub(crate) robot: a2ml_core::Robot,
     base: Option<String>,
     tip: Option<String>,
 }
@@ -310,8 +326,8 @@ impl PyRobot {
         let py = slf.py();
         let this = slf.get();
         let rebuild = slf.get_type().getattr("from_urdf_string")?;
-        let args =
-            (this.robot.urdf.as_str(), this.base.as_deref(), this.tip.as_deref()).into_pyobject(py)?;
+        let args = (this.robot.urdf.as_str(), this.base.as_deref(), this.tip.as_deref())
+            .into_pyobject(py)?;
         PyTuple::new(py, [rebuild, args.into_any()])
     }
 
@@ -523,6 +539,7 @@ fn _a2ml(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<language::PyTask>()?;
     m.add_function(wrap_pyfunction!(language::parse, m)?)?;
     m.add_function(wrap_pyfunction!(language::load, m)?)?;
+    m.add_function(wrap_pyfunction!(decompose::decompose, m)?)?;
     m.add("A2mlError", py.get_type::<A2mlError>())?;
     m.add("UrdfError", py.get_type::<UrdfError>())?;
     m.add("ParseError", py.get_type::<ParseError>())?;
@@ -530,5 +547,6 @@ fn _a2ml(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("JointLimitError", py.get_type::<JointLimitError>())?;
     m.add("SingularityError", py.get_type::<SingularityError>())?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
+    m.add("DecomposeError", py.get_type::<DecomposeError>())?;
     Ok(())
 }

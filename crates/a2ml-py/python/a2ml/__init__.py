@@ -10,14 +10,19 @@ shoulder centre. Arrays are float64 numpy arrays.
 >>> pw, ow, swivel = robot.cpsa([0.1, 0.5, 0.0, -1.2, 0.0, 0.4, 0.0])  # doctest: +SKIP
 >>> task = a2ml.load("push.a2ml")  # doctest: +SKIP
 >>> task.actions[0]["goal"]["primary"]["pw"]  # doctest: +SKIP
+>>> plan = a2ml.decompose(task)  # doctest: +SKIP
+>>> plan["actions"][0]["type"], plan["actions"][0]["segments"][0]["end"]  # doctest: +SKIP
 
 Invalid task text raises :class:`ParseError`, located by ``line`` and
-``column`` and rendered in full by ``str()``.
+``column`` and rendered in full by ``str()``; a task that cannot be
+decomposed raises :class:`DecomposeError`. :class:`Decomposition` and the
+other ``TypedDict`` classes describe what :func:`decompose` returns.
 """
 
 from a2ml._a2ml import (
     A2mlError,
     ConvergenceError,
+    DecomposeError,
     JointLimitError,
     ParseError,
     Robot,
@@ -26,21 +31,29 @@ from a2ml._a2ml import (
     UnreachableError,
     UrdfError,
     __version__,
+    decompose,
     load,
     parse,
 )
+from a2ml._types import Decomposition, OptReport, PlannedAction, PlannedSegment
 
 __all__ = [
     "A2mlError",
     "ConvergenceError",
+    "DecomposeError",
+    "Decomposition",
     "JointLimitError",
+    "OptReport",
     "ParseError",
+    "PlannedAction",
+    "PlannedSegment",
     "Robot",
     "SingularityError",
     "Task",
     "UnreachableError",
     "UrdfError",
     "__version__",
+    "decompose",
     "load",
     "parse",
 ]

@@ -11,7 +11,9 @@ infinite entry raises ``ValueError``. Rotation matrices must be orthonormal to
 A task (:func:`parse`, :func:`load`) comes back as plain Python data in SI
 units: state variables are spelled as :class:`Robot` names them (``"pw"``,
 ``"ow"``, ``"swivel"``, ``"os"``, ``"elbow"``), positions are arrays of shape
-(3,), rotations (3, 3), angles floats.
+(3,), rotations (3, 3), angles floats. :func:`decompose` turns a task into
+movement segments, returned in the same spelling (keys as in
+:class:`a2ml.Decomposition`).
 """
 
 import os
@@ -20,12 +22,15 @@ from typing import Any, ClassVar, final
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from a2ml._types import Decomposition
+
 __all__ = [
     "__version__",
     "Robot",
     "Task",
     "parse",
     "load",
+    "decompose",
     "A2mlError",
     "UrdfError",
     "ParseError",
@@ -33,6 +38,7 @@ __all__ = [
     "JointLimitError",
     "SingularityError",
     "ConvergenceError",
+    "DecomposeError",
 ]
 
 __version__: str
@@ -75,6 +81,13 @@ class SingularityError(A2mlError):
 class ConvergenceError(A2mlError):
     """Numerical IK did not converge, or the query needs a spherical shoulder
     and wrist (closed-form IK) that this arm lacks."""
+
+class DecomposeError(A2mlError):
+    """The task cannot be decomposed into actions and movement segments: it
+    has no ``start``, no order of the actions reaches its STRIPS goal, an
+    action's constraints fit none of the seven types, a path leaves out a
+    size nothing chooses, or a segment's goal is out of reach within the
+    joint limits. ``str(e)`` names the task or action (and segment)."""
 
 @final
 class Robot:
@@ -347,4 +360,32 @@ def load(path: str | os.PathLike[str]) -> Task:
     Raises:
         FileNotFoundError, PermissionError, OSError: the file cannot be read.
         ParseError: the text is not a valid task.
+    """
+
+def decompose(task: Task, robot: Robot | None = None) -> Decomposition:
+    """Decompose a task into movement segments (DESIGN.md §4).
+
+    The actions run in execution order (the STRIPS plan from ``init`` to
+    ``goal``, or the written order) from the task's start configuration; each
+    is classified (types I-VII) and split into segments whose open goals and
+    path sizes Opt1 and Opt2 fill in. ``robot`` defaults to the task's robot
+    file (:attr:`Task.robot`). Deterministic; releases the GIL.
+
+    Returns a dict (shape :class:`a2ml.Decomposition`): ``"task"`` (name),
+    ``"start"`` (joints, (7,)) and ``"actions"``, each with ``"index"`` (in
+    :attr:`Task.actions`), ``"name"``, ``"type"`` (``"I"`` ... ``"VII"``),
+    ``"type_number"`` (1-7), ``"description"`` (of the type),
+    ``"goal_space"``, ``"secondary_goal_space"``, ``"path_space"``
+    (``"cpsa"``, ``"hat"`` or None; the classification is all None for an
+    explicit action), ``"segments"`` and ``"optimisations"`` (``{"solver":
+    "Opt1" | "Opt2", "residual", "sizes", "evaluations"}``). A segment is
+    ``{"space", "pattern" (1, 2 or 3), "duration" (s), "duration_raised",
+    "solver", "relaxed" ([variable]), "start", "end" ((7,) joints),
+    "primitives"}`` with primitives as in an explicit segment of
+    :attr:`Task.actions`.
+
+    Raises:
+        DecomposeError: the task cannot be decomposed (the message says why).
+        UrdfError: ``robot`` is None and the task's robot file cannot be
+            loaded as a 7-DoF arm.
     """

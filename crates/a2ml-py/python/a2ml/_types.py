@@ -1,0 +1,92 @@
+"""The shapes of the plain data :func:`a2ml.decompose` returns, as
+``TypedDict`` classes (re-exported by :mod:`a2ml`) for annotating user code.
+
+At run time the values are ordinary ``dict`` objects; these classes only
+describe their keys. Joint vectors are float64 arrays of shape (7,) (rad),
+spaces are ``"cpsa"`` or ``"hat"``, variables are spelled as :class:`a2ml.Robot`
+names them (``"pw"``, ``"ow"``, ``"swivel"``, ``"os"``, ``"elbow"``).
+"""
+
+# Annotations stay evaluable on Python 3.9 (no ``X | None``), so
+# ``typing.get_type_hints`` works on every supported version.
+from typing import Any, Dict, List, Literal, Optional, TypedDict
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["Decomposition", "OptReport", "PlannedAction", "PlannedSegment"]
+
+# A space is ``"cpsa"`` (Pw, Ow, swivel) or ``"hat"`` (Os, elbow, Ow); spelled
+# out below rather than as an alias, which stubtest cannot compare.
+
+
+class OptReport(TypedDict):
+    """An optimisation that filled in goals or path sizes of an action.
+
+    ``solver`` is ``"Opt1"`` or ``"Opt2"``; ``residual`` the error of the goals
+    it could not meet exactly (m / rad); ``sizes`` the path sizes it chose
+    (Opt2; m for a line, rad for an angle), in the order of the path's items;
+    ``evaluations`` the candidates it evaluated.
+    """
+
+    solver: Literal["Opt1", "Opt2"]
+    residual: float
+    sizes: List[float]
+    evaluations: int
+
+
+class PlannedSegment(TypedDict):
+    """A movement segment with every value known.
+
+    ``space``; ``pattern`` 1 (every primitive a path or hold), 2 (every
+    primitive a goal) or 3 (both); ``duration`` (s) and ``duration_raised``
+    (whether it was raised to respect the joint velocity limits); ``solver``
+    (``"auto"``, ``"qp"``, ``"rrt"``, ...); ``relaxed``, the variables the
+    table held that had to move for the end to be within the joint limits;
+    ``start`` and ``end``, the joints it starts from and is expected to end
+    in; ``primitives`` in parallel, shaped as an explicit segment's in
+    :attr:`a2ml.Task.actions`, with goals and path sizes filled in.
+    """
+
+    space: Literal["cpsa", "hat"]
+    pattern: int
+    duration: float
+    duration_raised: bool
+    solver: str
+    relaxed: List[str]
+    start: NDArray[np.float64]
+    end: NDArray[np.float64]
+    primitives: List[Dict[str, Any]]
+
+
+class PlannedAction(TypedDict):
+    """One action, decomposed.
+
+    ``index`` in :attr:`a2ml.Task.actions` and ``name``; the classification:
+    ``type`` (``"I"`` ... ``"VII"``), ``type_number`` (1-7), ``description``
+    (what characterises the type), ``goal_space`` (of G, or of G1 when two
+    goals are prioritised), ``secondary_goal_space`` (of G2) and
+    ``path_space``, every one None for an explicit action and a space None
+    where the action has no such constraint; ``segments`` (joined by +Tr) and
+    ``optimisations`` that parameterised them, in order.
+    """
+
+    index: int
+    name: str
+    type: Optional[str]
+    type_number: Optional[int]
+    description: Optional[str]
+    goal_space: Optional[Literal["cpsa", "hat"]]
+    secondary_goal_space: Optional[Literal["cpsa", "hat"]]
+    path_space: Optional[Literal["cpsa", "hat"]]
+    segments: List[PlannedSegment]
+    optimisations: List[OptReport]
+
+
+class Decomposition(TypedDict):
+    """A decomposed task: its name ``task``, the ``start`` joints and the
+    ``actions`` in execution order (the STRIPS plan, or the written order)."""
+
+    task: str
+    start: NDArray[np.float64]
+    actions: List[PlannedAction]
