@@ -4,6 +4,7 @@
 use clap::{Parser, Subcommand};
 
 use crate::commands::check::CheckArgs;
+use crate::commands::explain::ExplainArgs;
 use crate::commands::fmt::FmtArgs;
 use crate::commands::robot::RobotArgs;
 
@@ -17,6 +18,7 @@ Examples:
   a2ml robot robots/panda.urdf --at 0,-45,0,-135,0,90,45 --deg --json
   a2ml check examples/*.a2ml
   a2ml fmt --write task.a2ml
+  a2ml explain examples/type_iv_forward_bar.a2ml
 
 Exit codes: 0 success, 1 I/O error, 2 invalid input.")]
 pub struct Cli {
@@ -34,4 +36,6 @@ pub enum Commands {
     Check(CheckArgs),
     /// Print a task file in canonical form, check that it is, or rewrite it.
     Fmt(FmtArgs),
+    /// Show how a task decomposes: actions, types, segments, primitives, Opt1/Opt2.
+    Explain(ExplainArgs),
 }

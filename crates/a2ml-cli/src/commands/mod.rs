@@ -2,6 +2,7 @@
 //! that calls the core and prints the result. [`run`] dispatches.
 
 pub mod check;
+pub mod explain;
 pub mod fmt;
 pub mod robot;
 
@@ -17,5 +18,6 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Commands::Robot(args) => robot::run(&args),
         Commands::Check(args) => check::run(&args),
         Commands::Fmt(args) => fmt::run(&args),
+        Commands::Explain(args) => explain::run(&args),
     }
 }

@@ -143,7 +143,7 @@ pub fn decompose(
 
 fn start_configuration(robot: &Robot, task: &Task) -> Result<JointVector, DecomposeError> {
     let unreachable =
-        |reason: String| DecomposeError::Unreachable { action: "start".into(), segment: 0, reason };
+        |reason: String| DecomposeError::InvalidStart { task: task.name.clone(), reason };
     match &task.start {
         None => Err(DecomposeError::NoStart { task: task.name.clone() }),
         Some(Start::Joints(q)) => match robot.limit_violation(q, 1e-9) {

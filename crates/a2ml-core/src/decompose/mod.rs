@@ -81,6 +81,14 @@ pub enum DecomposeError {
         /// The task.
         task: String,
     },
+    /// The start configuration is outside the joint limits or unreachable.
+    #[error("task `{task}`: the start is not a valid configuration: {reason}")]
+    InvalidStart {
+        /// The task.
+        task: String,
+        /// Why.
+        reason: String,
+    },
     /// A segment's goal cannot be reached within the joint limits.
     #[error("action `{action}`, segment {}: {reason}", segment + 1)]
     Unreachable {
