@@ -1,8 +1,7 @@
 //! Forward kinematics and the geometric and point Jacobians.
 
 use crate::math::{
-    DOF, Isometry, Jacobian3x7, Jacobian6x7, JointVector, Matrix3, Real, Rotation3, Vector3,
-    rotation_about,
+    DOF, Isometry, Jacobian3x7, Jacobian6x7, JointVector, Rotation3, Vector3, rotation_about,
 };
 use crate::robot::Robot;
 
@@ -32,21 +31,6 @@ impl ArmPose {
     }
 }
 
-/// `r · Rot(axis, angle)`; URDF axes are mostly ±x, ±y or ±z, where the
-/// product only mixes two columns.
-#[inline]
-fn spin(r: &Matrix3, axis: &Vector3, angle: Real) -> Matrix3 {
-    let principal = (0..3).find(|&k| axis[(k + 1) % 3] == 0.0 && axis[(k + 2) % 3] == 0.0);
-    let Some(k) = principal else { return r * rotation_about(axis, angle) };
-    let (s, c) = (axis[k] * angle).sin_cos();
-    let (a, b) = ((k + 1) % 3, (k + 2) % 3);
-    let (ca, cb) = (r.column(a).into_owned(), r.column(b).into_owned());
-    let mut out = *r;
-    out.set_column(a, &(ca * c + cb * s));
-    out.set_column(b, &(cb * c - ca * s));
-    out
-}
-
 /// Forward kinematics of every moving frame, the axes and S, E, W.
 pub fn arm_pose(robot: &Robot, q: &JointVector) -> ArmPose {
     let mut frames = [Isometry::identity(); DOF + 1];
@@ -63,7 +47,7 @@ pub fn arm_pose(robot: &Robot, q: &JointVector) -> ArmPose {
         };
         axes[k] = rotation * joint.axis;
         axis_points[k] = translation;
-        let spun = Rotation3::from_matrix_unchecked(spin(&rotation, &joint.axis, q[k]));
+        let spun = Rotation3::from_matrix_unchecked(rotation * rotation_about(&joint.axis, q[k]));
         frames[k + 1] = Isometry::from_parts(translation.into(), spun);
     }
     let s = &robot.structure;
