@@ -213,6 +213,29 @@ pub fn print(text: &str) -> Result<(), CliError> {
     }
 }
 
+/// Prints a report as pretty JSON (its warnings inside it), or as text with
+/// its warnings on stderr first.
+///
+/// # Errors
+/// [`CliError::Io`] when stdout cannot be written.
+pub fn emit<R: serde::Serialize>(
+    report: &R,
+    json: bool,
+    warnings: &[String],
+    text: impl FnOnce() -> String,
+) -> Result<(), CliError> {
+    if json {
+        let json = serde_json::to_string_pretty(report)
+            .map_err(|e| CliError::Io(format!("cannot write JSON: {e}")))?;
+        print(&(json + "\n"))
+    } else {
+        for warning in warnings {
+            warn(warning);
+        }
+        print(&text())
+    }
+}
+
 /// `n noun` or `n nouns`.
 pub fn count(n: usize, noun: &str) -> String {
     if n == 1 { format!("1 {noun}") } else { format!("{n} {noun}s") }

@@ -72,16 +72,7 @@ pub fn run(args: &ExplainArgs) -> Result<(), CliError> {
     let decomposition = decompose::decompose(&robot, &task, &DecomposeOptions::default())
         .map_err(|e| CliError::Input(format!("{}: {e}", args.file.display())))?;
     let report = ExplainReport::new(&args.file, &robot, &task, &decomposition);
-    if args.json {
-        let json = serde_json::to_string_pretty(&report)
-            .map_err(|e| CliError::Io(format!("cannot write JSON: {e}")))?;
-        output::print(&(json + "\n"))
-    } else {
-        for warning in &report.warnings {
-            output::warn(warning);
-        }
-        output::print(&report.to_text())
-    }
+    output::emit(&report, args.json, &report.warnings, || report.to_text())
 }
 
 /// Everything `a2ml explain` reports; its field names are the JSON keys.

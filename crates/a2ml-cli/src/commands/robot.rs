@@ -102,16 +102,7 @@ pub fn run(args: &RobotArgs) -> Result<(), CliError> {
         JointVector::from_fn(|i, _| if args.deg { values[i].to_radians() } else { values[i] })
     });
     let report = RobotReport::new(&robot, q.as_ref());
-    if args.json {
-        let json = serde_json::to_string_pretty(&report)
-            .map_err(|e| CliError::Io(format!("cannot write JSON: {e}")))?;
-        output::print(&(json + "\n"))
-    } else {
-        for warning in &report.warnings {
-            output::warn(warning);
-        }
-        output::print(&report.to_text())
-    }
+    output::emit(&report, args.json, &report.warnings, || report.to_text())
 }
 
 /// Everything `a2ml robot` reports; its field names are the JSON keys.
