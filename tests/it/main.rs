@@ -1,5 +1,6 @@
 //! Integration tests of the a2ml library, one module per area.
 
+mod collision;
 mod common;
 mod decompose;
 mod errors;

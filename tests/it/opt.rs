@@ -54,7 +54,7 @@ fn opt1_finds_the_swivel_that_matches_the_shoulder_frame() {
             let target = state(&robot, &q1);
             let g1 = goals(&target, &[Variable::Pw, Variable::Ow]);
             let g2 = goals(&target, &[Variable::Os]);
-            let sol = opt1(&robot, &g1, &g2, &q0, &OptOptions::default()).expect("feasible");
+            let sol = opt1(&robot, &g1, &g2, &q0, None, &OptOptions::default()).expect("feasible");
             assert!(goal_error(&sol.state, &g1) < 1e-9, "{name}: G1 not kept");
             assert!(sol.residual < 1e-6, "{name}: G2 residual {}", sol.residual);
             assert_reaches(&robot, &sol.q, &sol.state);
@@ -80,7 +80,9 @@ fn opt1_reduces_the_secondary_error_of_the_first_segment() {
             let g2 = vec![(Variable::Os, Target::Rotation(os))];
             let start = state(&robot, &q0);
             let ms1_end = a2ml::language::Target::Angle(start.cpsa.swivel);
-            let Ok(sol) = opt1(&robot, &g1, &g2, &q0, &OptOptions::default()) else { continue };
+            let Ok(sol) = opt1(&robot, &g1, &g2, &q0, None, &OptOptions::default()) else {
+                continue;
+            };
             assert!(goal_error(&sol.state, &g1) < 1e-9);
             // The end of MS1: G1 reached with the swivel unchanged, if reachable.
             let Target::Angle(sw) = ms1_end else { unreachable!() };
@@ -113,7 +115,9 @@ fn opt1_from_hat_finds_the_shoulder_frame_for_a_wrist_position() {
             let target = state(&robot, &q1);
             let g1 = goals(&target, &[Variable::Elbow, Variable::Ow]);
             let g2 = goals(&target, &[Variable::Pw]);
-            let Ok(sol) = opt1(&robot, &g1, &g2, &q0, &OptOptions::default()) else { continue };
+            let Ok(sol) = opt1(&robot, &g1, &g2, &q0, None, &OptOptions::default()) else {
+                continue;
+            };
             assert!(goal_error(&sol.state, &g1) < 1e-9);
             assert_reaches(&robot, &sol.q, &sol.state);
             solved += usize::from(sol.residual < 1e-6);
@@ -145,7 +149,7 @@ fn opt2_recovers_the_length_of_a_hard_wrist_line() {
                 span: Default::default(),
             };
             let g = goals(&s1, &[Variable::Os, Variable::Ow]);
-            let sol = opt2(&robot, &g, &path, &q0, &OptOptions::default()).expect("feasible");
+            let sol = opt2(&robot, &g, &path, &q0, None, &OptOptions::default()).expect("feasible");
             // Pw stays on the line whatever else happens.
             let off_line = (sol.state.cpsa.pw - s0.cpsa.pw).cross(&direction).norm();
             assert!(off_line < 1e-12, "{name}: end off the line by {off_line}");
@@ -199,8 +203,8 @@ fn opt2_recovers_a_shoulder_rotation_about_the_upper_arm() {
             };
             // A reachable target: Opt2 must find it.
             attempted += 1;
-            let sol =
-                opt2(&robot, &g, &path, &q0, &OptOptions::default()).expect("reachable target");
+            let sol = opt2(&robot, &g, &path, &q0, None, &OptOptions::default())
+                .expect("reachable target");
             if sol.residual < 1e-6 {
                 assert!(
                     (sol.sizes[0] - angle).abs() < 1e-5,
@@ -224,8 +228,58 @@ fn opt_is_deterministic() {
     let target = state(&robot, &q1);
     let g1 = goals(&target, &[Variable::Pw, Variable::Ow]);
     let g2 = goals(&target, &[Variable::Os]);
-    let a = opt1(&robot, &g1, &g2, &q0, &OptOptions::default()).expect("feasible");
-    let b = opt1(&robot, &g1, &g2, &q0, &OptOptions::default()).expect("feasible");
+    let a = opt1(&robot, &g1, &g2, &q0, None, &OptOptions::default()).expect("feasible");
+    let b = opt1(&robot, &g1, &g2, &q0, None, &OptOptions::default()).expect("feasible");
     assert_eq!(a.q, b.q);
     assert_eq!(a.residual, b.residual);
+}
+
+/// Opt1 keeps the clearance: a sphere placed on the elbow of the
+/// unobstructed answer pushes the answer elsewhere on G1's swivel circle.
+#[test]
+fn opt1_keeps_clear_of_obstacles() {
+    use a2ml::collision::{CollisionScene, min_distance};
+    use a2ml::language::{Obstacle, Shape};
+    for name in ARMS {
+        let robot = load(name);
+        let mut rng = rng(36);
+        let mut moved = 0;
+        for _ in 0..10 {
+            let (q0, _) = regular_q(&robot, &mut rng, 0.1);
+            let (q1, _) = regular_q(&robot, &mut rng, 0.1);
+            let target = state(&robot, &q1);
+            let g1 = goals(&target, &[Variable::Pw, Variable::Ow]);
+            let g2 = goals(&target, &[Variable::Os]);
+            let free = opt1(&robot, &g1, &g2, &q0, None, &OptOptions::default()).expect("feasible");
+            let elbow = a2ml::kinematics::arm_pose(&robot, &free.q).elbow;
+            let scene = CollisionScene::new(&[Obstacle {
+                name: "ball".into(),
+                shape: Shape::Sphere { center: elbow, radius: 0.03 },
+            }]);
+            let options = OptOptions::default();
+            let Ok(sol) = opt1(&robot, &g1, &g2, &q0, Some(&scene), &options) else {
+                // No answer: then no swivel angle keeps G1 clear (dense re-check).
+                for k in 0..720 {
+                    let swivel = -std::f64::consts::PI + k as f64 * std::f64::consts::PI / 360.0;
+                    let cpsa = a2ml::kinematics::CpsaState { swivel, ..target.cpsa };
+                    for q in ik_cpsa(&robot, &cpsa, Some(&q0)).unwrap_or_default() {
+                        let pose = a2ml::kinematics::arm_pose(&robot, &q);
+                        let (d, ..) = min_distance(&robot, &pose, &scene).expect("pairs");
+                        assert!(
+                            d < options.clearance + 1e-3,
+                            "{name}: missed a clear swivel {swivel}"
+                        );
+                    }
+                }
+                continue;
+            };
+            let (d, ..) = min_distance(&robot, &a2ml::kinematics::arm_pose(&robot, &sol.q), &scene)
+                .expect("pairs");
+            assert!(d >= options.clearance, "{name}: clearance {d}");
+            assert!(goal_error(&sol.state, &g1) < 1e-9, "{name}: G1 not kept");
+            assert!(sol.residual >= free.residual - 1e-12);
+            moved += 1;
+        }
+        assert!(moved >= 3, "{name}: only {moved} cases found a clear answer");
+    }
 }

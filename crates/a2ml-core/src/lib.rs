@@ -5,8 +5,9 @@
 //! [`kinematics`] (FK, CPSA and HAT states, Jacobians, IK), [`language`]
 //! (task files to a validated [`language::Task`]), [`decompose`] (action
 //! order and types), [`profile`] (bell profiles, references, weights and
-//! the joining of segments).
+//! the joining of segments), [`collision`] (arm capsules against the scene).
 
+pub mod collision;
 pub mod decompose;
 pub mod error;
 pub mod kinematics;

@@ -11,6 +11,7 @@ use super::{
     ActionType, Classification, DecomposeError, SegmentPattern, StripsOptions, classify,
     order_with, segment_pattern,
 };
+use crate::collision::CollisionScene;
 use crate::kinematics::{CpsaState, HatState, ik_cpsa, ik_hat};
 use crate::language::{
     ActionBody, GoalConstraint, PathConstraint, PathFeature, Primitive, PrimitiveConstraint,
@@ -129,10 +130,11 @@ pub fn decompose(
 ) -> Result<Decomposition, DecomposeError> {
     let start = start_configuration(robot, task)?;
     let order = order_with(task, &options.strips)?;
+    let scene = CollisionScene::new(&task.scene);
     let mut q = start;
     let mut actions = Vec::with_capacity(order.len());
     for index in order {
-        let planned = Planner { robot, task, options, index }.action(q)?;
+        let planned = Planner { robot, task, options, scene: &scene, index }.action(q)?;
         if let Some(last) = planned.segments.last() {
             q = last.end;
         }
@@ -181,6 +183,7 @@ struct Planner<'a> {
     robot: &'a Robot,
     task: &'a Task,
     options: &'a DecomposeOptions,
+    scene: &'a CollisionScene,
     index: usize,
 }
 
@@ -278,8 +281,8 @@ impl Planner<'_> {
             ActionType::III => {
                 let ms1 =
                     self.complete(0, goal_space, goal_primitives(&g1), q, None, Fill::Hold)?;
-                let sol =
-                    opt1(self.robot, &g1, &g2, &ms1.end, opt).map_err(|e| self.opt_failed(1, e))?;
+                let sol = opt1(self.robot, &g1, &g2, &ms1.end, Some(self.scene), opt)
+                    .map_err(|e| self.opt_failed(1, e))?;
                 record("Opt1", &sol);
                 let g3 = complement_targets(goal_space, &g1, &sol.state);
                 let mut prims = hold_primitives(&g1);
@@ -289,8 +292,8 @@ impl Planner<'_> {
             }
             ActionType::IV | ActionType::V => {
                 let path = path.ok_or_else(|| self.unreachable(0, "a path is needed".into()))?;
-                let sol =
-                    opt2(self.robot, &g1, path, &q, opt).map_err(|e| self.opt_failed(0, e))?;
+                let sol = opt2(self.robot, &g1, path, &q, Some(self.scene), opt)
+                    .map_err(|e| self.opt_failed(0, e))?;
                 record("Opt2", &sol);
                 let fill = Fill::GoalAt(sol.state);
                 let ms1 = self.path_segment(0, path_space, path, Some(&sol.sizes), q, fill)?;
@@ -301,7 +304,7 @@ impl Planner<'_> {
                 // stay to where MS1 ended.
                 let end = self.state(&ms1.end, 0)?;
                 let rest = complement_targets(goal_space, &g1, &end);
-                let sol = opt1(self.robot, &g1, &rest, &ms1.end, opt)
+                let sol = opt1(self.robot, &g1, &rest, &ms1.end, Some(self.scene), opt)
                     .map_err(|e| self.opt_failed(1, e))?;
                 record("Opt1", &sol);
                 let g4 = complement_targets(goal_space, &g1, &sol.state);
@@ -313,14 +316,14 @@ impl Planner<'_> {
             ActionType::VI | ActionType::VII => {
                 let path = path.ok_or_else(|| self.unreachable(0, "a path is needed".into()))?;
                 // The goal configuration: G1 with the rest of its space from Opt1.
-                let sol1 =
-                    opt1(self.robot, &g1, &g2, &q, opt).map_err(|e| self.opt_failed(0, e))?;
+                let sol1 = opt1(self.robot, &g1, &g2, &q, Some(self.scene), opt)
+                    .map_err(|e| self.opt_failed(0, e))?;
                 record("Opt1", &sol1);
                 let g4 = complement_targets(goal_space, &g1, &sol1.state);
                 let mut whole = g1.clone();
                 whole.extend(g4.iter().copied());
-                let sol2 =
-                    opt2(self.robot, &whole, path, &q, opt).map_err(|e| self.opt_failed(0, e))?;
+                let sol2 = opt2(self.robot, &whole, path, &q, Some(self.scene), opt)
+                    .map_err(|e| self.opt_failed(0, e))?;
                 record("Opt2", &sol2);
                 let fill = Fill::GoalAt(sol2.state);
                 let ms1 = self.path_segment(0, path_space, path, Some(&sol2.sizes), q, fill)?;
@@ -475,9 +478,9 @@ impl Planner<'_> {
             .map(|(v, t)| (*v, *t))
             .collect();
         let keep: Targets = held.iter().map(|v| (*v, start.value(*v))).collect();
-        let sol = opt1(self.robot, &fixed, &keep, q, &self.options.opt).map_err(|e| {
-            self.unreachable(k, format!("{reason}; relaxing the held variables: {e}"))
-        })?;
+        let sol = opt1(self.robot, &fixed, &keep, q, Some(self.scene), &self.options.opt).map_err(
+            |e| self.unreachable(k, format!("{reason}; relaxing the held variables: {e}")),
+        )?;
         let mut prims: Vec<Primitive> = primitives
             .into_iter()
             .filter(|p| !(matches!(p.constraint, PrimitiveConstraint::Hold) && p.variables == held))

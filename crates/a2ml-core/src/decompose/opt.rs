@@ -4,9 +4,11 @@
 //! Both work on the variables of one space. The fixed ones come from a goal
 //! (Opt1) or from a path and its size (Opt2); the free ones are searched by
 //! Levenberg-Marquardt with multistart, every candidate checked through the
-//! CPSA <-> HAT mapping and IK within the joint limits. A one-dimensional
-//! search over θsw first samples the closed-form feasible swivel intervals.
+//! CPSA <-> HAT mapping and IK within the joint limits, and kept clear of
+//! the scene by [`OptOptions::clearance`]. A one-dimensional search over θsw
+//! first samples the closed-form feasible swivel intervals.
 
+use crate::collision::{CollisionScene, min_distance};
 use crate::kinematics::{
     CpsaState, HatState, KinematicsError, arm_pose, cpsa_state, cpsa_to_hat, hat_state,
     hat_to_cpsa, ik_cpsa, swivel_intervals,
@@ -124,6 +126,9 @@ pub struct OptOptions {
     pub max_path_size: Real,
     /// Samples of the feasible swivel range for a search over θsw alone.
     pub swivel_samples: usize,
+    /// Smallest distance (m) every arm capsule keeps from the obstacles and
+    /// from the other links, at the end and along a hard path.
+    pub clearance: Real,
 }
 
 impl Default for OptOptions {
@@ -135,6 +140,7 @@ impl Default for OptOptions {
             path_checks: 8,
             max_path_size: 1.0,
             swivel_samples: 72,
+            clearance: 0.01,
         }
     }
 }
@@ -182,6 +188,7 @@ struct Search<'a> {
     fixed: Vec<(Variable, Target)>,
     goals: &'a [(Variable, Target)],
     options: &'a OptOptions,
+    scene: Option<&'a CollisionScene>,
     evaluations: usize,
 }
 
@@ -296,15 +303,28 @@ impl Search<'_> {
         self.evaluations += 1;
         let end = ArmState::from_space(self.robot, self.space, &self.values(x, 1.0))?;
         let q = ik_cpsa(self.robot, &end.cpsa, Some(&self.start_q)).ok()?.first().copied()?;
+        if !self.clear(&q) {
+            return None;
+        }
         // Only a hard path must stay reachable all along; elsewhere the
         // solver chooses the way and only the end has to be reachable.
         let checks = if self.path.is_some_and(|p| p.hard) { self.options.path_checks } else { 0 };
         for k in 1..=checks {
             let f = k as Real / (self.options.path_checks + 1) as Real;
             let mid = ArmState::from_space(self.robot, self.space, &self.values(x, f))?;
-            ik_cpsa(self.robot, &mid.cpsa, Some(&q)).ok()?;
+            let q_mid = ik_cpsa(self.robot, &mid.cpsa, Some(&q)).ok()?[0];
+            if !self.clear(&q_mid) {
+                return None;
+            }
         }
         Some((end, q))
+    }
+
+    /// Whether the arm at `q` keeps the clearance from the scene and itself.
+    fn clear(&self, q: &JointVector) -> bool {
+        let Some(scene) = self.scene else { return true };
+        min_distance(self.robot, &arm_pose(self.robot, q), scene)
+            .is_none_or(|(d, ..)| d >= self.options.clearance)
     }
 
     fn residual(&mut self, x: &[Real], out: &mut Vec<Real>) -> Option<(ArmState, JointVector)> {
@@ -576,6 +596,7 @@ pub fn opt1(
     g1: &[(Variable, Target)],
     g2: &[(Variable, Target)],
     start: &JointVector,
+    scene: Option<&CollisionScene>,
     options: &OptOptions,
 ) -> Result<OptSolution, OptError> {
     let space = space_of(g1)
@@ -594,6 +615,7 @@ pub fn opt1(
         fixed: g1.to_vec(),
         goals: g2,
         options,
+        scene,
         evaluations: 0,
     }
     .solve()
@@ -617,6 +639,7 @@ pub fn opt2(
     g: &[(Variable, Target)],
     path: &PathConstraint,
     start: &JointVector,
+    scene: Option<&CollisionScene>,
     options: &OptOptions,
 ) -> Result<OptSolution, OptError> {
     let path_vars: Vec<Variable> =
@@ -647,6 +670,7 @@ pub fn opt2(
         fixed: Vec::new(),
         goals: g,
         options,
+        scene,
         evaluations: 0,
     }
     .solve()

@@ -1,0 +1,324 @@
+//! Distances between the arm's capsules and the task's obstacles, shared by
+//! every solver that keeps the arm clear (Opt1/Opt2, the velocity QP, RRT).
+//!
+//! Entry points: [`CollisionScene::new`], [`arm_capsules`], [`distances`],
+//! [`min_distance`]. Everything is in {b}, SI units. parry enters the crate
+//! here only; its glam types never leave this module.
+
+use parry3d_f64::math::{Pose, Vector};
+use parry3d_f64::query::{self, Contact};
+use parry3d_f64::shape::{Ball, Cuboid, Cylinder, Segment, Shape as ParryShape};
+
+use crate::kinematics::ArmPose;
+use crate::language::{Obstacle, Shape};
+use crate::math::{Real, Vector3};
+use crate::robot::{LinkRole, Robot};
+
+/// The task's obstacles as parry shapes, positioned in {b}.
+///
+/// Positions are read as {b} coordinates whatever `settings.frame` says:
+/// scenes written in the URDF root frame are not yet converted.
+#[derive(Debug, Clone)]
+pub struct CollisionScene {
+    bodies: Vec<Body>,
+}
+
+impl CollisionScene {
+    /// Builds the scene from validated obstacles (positions in {b}).
+    pub fn new(obstacles: &[Obstacle]) -> Self {
+        Self { bodies: obstacles.iter().map(Body::from_obstacle).collect() }
+    }
+
+    /// Names of the obstacles, in the order given.
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        self.bodies.iter().map(|b| b.name.as_str())
+    }
+
+    /// Number of obstacles.
+    pub fn len(&self) -> usize {
+        self.bodies.len()
+    }
+
+    /// Whether the scene has no obstacle.
+    pub fn is_empty(&self) -> bool {
+        self.bodies.is_empty()
+    }
+}
+
+/// One link capsule placed in {b}.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PosedCapsule {
+    /// The capsule's name (URDF collision name, else link name).
+    pub name: String,
+    /// Part of the arm carrying it.
+    pub role: LinkRole,
+    /// Segment end in {b} (m).
+    pub a: Vector3,
+    /// Other segment end in {b} (m).
+    pub b: Vector3,
+    /// Radius (m).
+    pub radius: Real,
+}
+
+/// Settings of [`distances`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DistanceOptions {
+    /// Pairs at this distance or farther are not reported (m), default 0.1.
+    pub influence: Real,
+}
+
+impl Default for DistanceOptions {
+    fn default() -> Self {
+        Self { influence: 0.1 }
+    }
+}
+
+/// The closest points of a link capsule and an obstacle (or another link).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Proximity {
+    /// The link capsule's name.
+    pub link: String,
+    /// The obstacle's name, or the other capsule's name for self-collision.
+    pub obstacle: String,
+    /// Signed distance (m): negative is the penetration depth.
+    pub distance: Real,
+    /// Closest point on the link capsule, {b}.
+    pub on_link: Vector3,
+    /// Closest point on the obstacle, {b}.
+    pub on_obstacle: Vector3,
+    /// Unit normal from the obstacle to the link, {b}.
+    pub normal: Vector3,
+}
+
+/// The link capsules at `pose`, in {b}.
+pub fn arm_capsules(robot: &Robot, pose: &ArmPose) -> Vec<PosedCapsule> {
+    robot
+        .capsules
+        .iter()
+        .map(|c| {
+            let b_from_frame = &pose.frames[c.frame];
+            PosedCapsule {
+                name: c.name.clone(),
+                role: c.role,
+                a: b_from_frame.transform_point(&c.a.into()).coords,
+                b: b_from_frame.transform_point(&c.b.into()).coords,
+                radius: c.radius,
+            }
+        })
+        .collect()
+}
+
+/// Every moving link capsule × obstacle pair, plus the self-collision pairs
+/// (see [`self_pairs`]), closer than `options.influence`.
+///
+/// Pairs whose bounding spheres are already `influence` apart are skipped
+/// without a narrow-phase query.
+pub fn distances(
+    robot: &Robot,
+    pose: &ArmPose,
+    scene: &CollisionScene,
+    options: &DistanceOptions,
+) -> Vec<Proximity> {
+    let influence = options.influence;
+    let mut out = Vec::new();
+    for_each_pair(robot, pose, scene, |link, other| {
+        if bounding_gap(link, other) >= influence {
+            return;
+        }
+        if let Some(p) = proximity(link, other, influence) {
+            if p.distance < influence {
+                out.push(p);
+            }
+        }
+    });
+    out
+}
+
+/// The smallest signed distance over the pairs [`distances`] considers, and
+/// the pair (link, obstacle); `None` when there is no pair.
+pub fn min_distance(
+    robot: &Robot,
+    pose: &ArmPose,
+    scene: &CollisionScene,
+) -> Option<(Real, String, String)> {
+    let mut best: Option<(Real, String, String)> = None;
+    for_each_pair(robot, pose, scene, |link, other| {
+        let bound = best.as_ref().map_or(Real::INFINITY, |b| b.0);
+        // Broad phase against the best so far.
+        if bounding_gap(link, other) >= bound {
+            return;
+        }
+        // Prediction large enough to always find the pair: the farthest
+        // two points of the bounding spheres.
+        let reach = (link.center - other.center).norm() + link.bound + other.bound + 1.0;
+        if let Some(p) = proximity(link, other, reach.min(bound)) {
+            if p.distance < bound {
+                best = Some((p.distance, p.link, p.obstacle));
+            }
+        }
+    });
+    best
+}
+
+/// Self-collision pairs (first the moving link, second the one treated as
+/// the obstacle): hand vs upper arm, hand vs base, forearm vs base. Base
+/// vs upper arm is skipped: they touch at the shoulder by construction, as
+/// do neighbouring parts at the elbow and wrist.
+pub fn self_pairs() -> &'static [(LinkRole, LinkRole)] {
+    &[
+        (LinkRole::Hand, LinkRole::UpperArm),
+        (LinkRole::Hand, LinkRole::Base),
+        (LinkRole::Forearm, LinkRole::Base),
+    ]
+}
+
+/// A convex body in {b}: a parry shape, its pose, and a radius added
+/// around it (capsules are segments plus a radius, which keeps parry on its
+/// exact point/segment/polytope paths).
+#[derive(Debug, Clone)]
+struct Body {
+    name: String,
+    shape: Core,
+    pose: Pose,
+    margin: Real,
+    /// Bounding sphere centre, {b}.
+    center: Vector3,
+    /// Bounding sphere radius, margin included.
+    bound: Real,
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Core {
+    Ball(Ball),
+    Segment(Segment),
+    Cuboid(Cuboid),
+    Cylinder(Cylinder),
+}
+
+impl Core {
+    fn as_dyn(&self) -> &dyn ParryShape {
+        match self {
+            Self::Ball(s) => s,
+            Self::Segment(s) => s,
+            Self::Cuboid(s) => s,
+            Self::Cylinder(s) => s,
+        }
+    }
+}
+
+fn to_parry(v: &Vector3) -> Vector {
+    Vector::new(v.x, v.y, v.z)
+}
+
+fn from_parry(v: Vector) -> Vector3 {
+    Vector3::new(v.x, v.y, v.z)
+}
+
+impl Body {
+    fn from_obstacle(o: &Obstacle) -> Self {
+        let name = o.name.clone();
+        match &o.shape {
+            Shape::Box { center, size } => Self {
+                name,
+                shape: Core::Cuboid(Cuboid::new(to_parry(&(size * 0.5)))),
+                pose: Pose::from_translation(to_parry(center)),
+                margin: 0.0,
+                center: *center,
+                bound: 0.5 * size.norm(),
+            },
+            Shape::Sphere { center, radius } => Self {
+                name,
+                shape: Core::Ball(Ball::new(*radius)),
+                pose: Pose::from_translation(to_parry(center)),
+                margin: 0.0,
+                center: *center,
+                bound: *radius,
+            },
+            Shape::Capsule { a, b, radius } => Self::capsule(name, a, b, *radius),
+            Shape::Cylinder { center, radius, height } => Self {
+                name,
+                shape: Core::Cylinder(Cylinder::new(0.5 * height, *radius)),
+                // parry's cylinder runs along y; turn y onto z.
+                pose: Pose::new(
+                    to_parry(center),
+                    Vector::new(std::f64::consts::FRAC_PI_2, 0.0, 0.0),
+                ),
+                margin: 0.0,
+                center: *center,
+                bound: radius.hypot(0.5 * height),
+            },
+        }
+    }
+
+    fn capsule(name: String, a: &Vector3, b: &Vector3, radius: Real) -> Self {
+        Self {
+            name,
+            shape: Core::Segment(Segment::new(to_parry(a), to_parry(b))),
+            pose: Pose::IDENTITY,
+            margin: radius,
+            center: 0.5 * (a + b),
+            bound: 0.5 * (b - a).norm() + radius,
+        }
+    }
+
+    fn from_capsule(c: &PosedCapsule) -> Self {
+        Self::capsule(c.name.clone(), &c.a, &c.b, c.radius)
+    }
+}
+
+/// Calls `f(link, obstacle)` for every pair [`distances`] considers.
+fn for_each_pair(
+    robot: &Robot,
+    pose: &ArmPose,
+    scene: &CollisionScene,
+    mut f: impl FnMut(&Body, &Body),
+) {
+    let capsules = arm_capsules(robot, pose);
+    let bodies: Vec<(LinkRole, Body)> =
+        capsules.iter().map(|c| (c.role, Body::from_capsule(c))).collect();
+    for (role, link) in bodies.iter().filter(|(r, _)| *r != LinkRole::Base) {
+        for obstacle in &scene.bodies {
+            f(link, obstacle);
+        }
+        for (_, other) in self_pairs()
+            .iter()
+            .filter(|(moving, _)| moving == role)
+            .flat_map(|(_, against)| bodies.iter().filter(move |(r, _)| r == against))
+        {
+            f(link, other);
+        }
+    }
+}
+
+/// Lower bound of the distance between two bodies from their bounding spheres.
+fn bounding_gap(a: &Body, b: &Body) -> Real {
+    (a.center - b.center).norm() - a.bound - b.bound
+}
+
+/// The signed distance and closest points of `link` and `obstacle`, if
+/// closer than `prediction`.
+fn proximity(link: &Body, obstacle: &Body, prediction: Real) -> Option<Proximity> {
+    let margins = link.margin + obstacle.margin;
+    // Shape 1 is the obstacle, so parry's normal1 points from it to the link.
+    let contact: Contact = query::contact(
+        &obstacle.pose,
+        obstacle.shape.as_dyn(),
+        &link.pose,
+        link.shape.as_dyn(),
+        (prediction + margins).max(0.0),
+    )
+    // Every pair of the four shapes is supported by parry's default dispatcher.
+    .ok()??;
+    let normal = from_parry(contact.normal1);
+    Some(Proximity {
+        link: link.name.clone(),
+        obstacle: obstacle.name.clone(),
+        distance: contact.dist - margins,
+        on_link: from_parry(contact.point2) - normal * link.margin,
+        on_obstacle: from_parry(contact.point1) + normal * obstacle.margin,
+        normal,
+    })
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,173 @@
+//! Capsule-obstacle distances against independent brute force.
+
+use crate::common::{load, random_q, rng};
+use a2ml::collision::*;
+use a2ml::kinematics::arm_pose;
+use a2ml::language::{Obstacle, Shape};
+use a2ml::math::{Real, Vector3};
+use a2ml::robot::LinkRole;
+use rand::RngExt;
+use rand::rngs::StdRng;
+
+const TOL: Real = 1e-9;
+
+/// The closest point of segment [a, b] to p.
+fn closest_on_segment(a: &Vector3, b: &Vector3, p: &Vector3) -> Vector3 {
+    let ab = b - a;
+    let len2 = ab.norm_squared();
+    let t = if len2 > 0.0 { ((p - a).dot(&ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    a + ab * t
+}
+
+fn random_vector(rng: &mut StdRng, half: Real) -> Vector3 {
+    Vector3::new(
+        rng.random_range(-half..half),
+        rng.random_range(-half..half),
+        rng.random_range(-half..half),
+    )
+}
+
+fn sphere(center: Vector3, radius: Real) -> Obstacle {
+    Obstacle { name: "ball".into(), shape: Shape::Sphere { center, radius } }
+}
+
+#[test]
+fn capsule_sphere_matches_brute_force() {
+    let robot = load("coman_right_arm");
+    let mut rng = rng(7);
+    let mut penetrating = 0;
+    for _ in 0..500 {
+        let pose = arm_pose(&robot, &random_q(&robot, &mut rng));
+        let capsules = arm_capsules(&robot, &pose);
+        // Sometimes centred on a link's axis, to exercise penetration.
+        let center = if rng.random_range(0.0..1.0) < 0.2 {
+            let c = &capsules[rng.random_range(0..capsules.len())];
+            c.a + (c.b - c.a) * rng.random_range(0.0..1.0)
+        } else {
+            random_vector(&mut rng, 0.6)
+        };
+        let radius = rng.random_range(0.01..0.2);
+        let scene = CollisionScene::new(&[sphere(center, radius)]);
+        let influence = rng.random_range(0.02..0.5);
+        let found = distances(&robot, &pose, &scene, &DistanceOptions { influence });
+
+        for c in capsules.iter().filter(|c| c.role != LinkRole::Base) {
+            let on_axis = closest_on_segment(&c.a, &c.b, &center);
+            let expected = (on_axis - center).norm() - c.radius - radius;
+            let hit = found.iter().find(|p| p.link == c.name && p.obstacle == "ball");
+            let Some(p) = hit else {
+                // The broad phase may only drop pairs at or beyond the influence.
+                assert!(expected >= influence - TOL, "{}: dropped at {expected}", c.name);
+                continue;
+            };
+            assert!(expected < influence + TOL);
+            assert!(
+                (p.distance - expected).abs() < TOL,
+                "{}: {} vs {expected}",
+                c.name,
+                p.distance
+            );
+            if p.distance <= 0.0 {
+                penetrating += 1;
+            }
+            // Closest points on the surfaces.
+            assert!(((p.on_obstacle - center).norm() - radius).abs() < TOL);
+            let axis_point = closest_on_segment(&c.a, &c.b, &p.on_link);
+            assert!(((p.on_link - axis_point).norm() - c.radius).abs() < TOL);
+            // Unit normal from the obstacle to the link.
+            assert!((p.normal.norm() - 1.0).abs() < TOL);
+            if (on_axis - center).norm() > 1e-6 {
+                let n = (on_axis - center).normalize();
+                assert!((p.normal - n).norm() < 1e-7, "{:?} vs {n:?}", p.normal);
+            }
+            assert!(((p.on_link - p.on_obstacle) - p.normal * p.distance).norm() < TOL);
+        }
+    }
+    assert!(penetrating > 20, "too few penetrations exercised: {penetrating}");
+}
+
+fn random_scene(rng: &mut StdRng) -> Vec<Obstacle> {
+    (0..6)
+        .map(|i| {
+            let center = random_vector(rng, 0.6);
+            let shape = match i % 4 {
+                0 => Shape::Sphere { center, radius: rng.random_range(0.02..0.2) },
+                1 => Shape::Box {
+                    center,
+                    size: Vector3::new(
+                        rng.random_range(0.02..0.4),
+                        rng.random_range(0.02..0.4),
+                        rng.random_range(0.02..0.4),
+                    ),
+                },
+                2 => Shape::Capsule {
+                    a: center,
+                    b: center + random_vector(rng, 0.2),
+                    radius: rng.random_range(0.01..0.1),
+                },
+                _ => Shape::Cylinder {
+                    center,
+                    radius: rng.random_range(0.02..0.2),
+                    height: rng.random_range(0.02..0.5),
+                },
+            };
+            Obstacle { name: format!("o{i}"), shape }
+        })
+        .collect()
+}
+
+#[test]
+fn broad_phase_never_drops_a_close_pair() {
+    let robot = load("coman_right_arm");
+    let moving = robot.capsules.iter().filter(|c| c.role != LinkRole::Base).count();
+    let mut rng = rng(11);
+    for _ in 0..200 {
+        let pose = arm_pose(&robot, &random_q(&robot, &mut rng));
+        let scene = CollisionScene::new(&random_scene(&mut rng));
+        // An influence no bounding sphere can exceed: every pair, queried.
+        let all = distances(&robot, &pose, &scene, &DistanceOptions { influence: 1e3 });
+        assert!(all.len() >= moving * scene.len());
+        let influence = rng.random_range(0.01..0.3);
+        let near = distances(&robot, &pose, &scene, &DistanceOptions { influence });
+        for p in &all {
+            let kept = near.iter().find(|n| n.link == p.link && n.obstacle == p.obstacle);
+            if p.distance < influence - TOL {
+                let kept = kept.unwrap_or_else(|| panic!("dropped {} {}", p.link, p.obstacle));
+                assert!((kept.distance - p.distance).abs() < TOL);
+            } else if p.distance > influence + TOL {
+                assert!(kept.is_none());
+            }
+            assert!((p.normal.norm() - 1.0).abs() < TOL);
+        }
+        // min_distance is the smallest of them all.
+        let best = all.iter().min_by(|a, b| a.distance.total_cmp(&b.distance));
+        let (d, link, obstacle) = min_distance(&robot, &pose, &scene).expect("pairs exist");
+        let best = best.expect("pairs exist");
+        assert!((d - best.distance).abs() < TOL, "{d} vs {}", best.distance);
+        let named = all.iter().find(|p| p.link == link && p.obstacle == obstacle);
+        assert!(named.is_some_and(|p| (p.distance - d).abs() < TOL), "{link} {obstacle}");
+    }
+}
+
+#[test]
+fn empty_scene_keeps_self_pairs_only() {
+    let robot = load("coman_right_arm");
+    let pose = arm_pose(&robot, &random_q(&robot, &mut rng(3)));
+    let scene = CollisionScene::new(&[]);
+    let all = distances(&robot, &pose, &scene, &DistanceOptions { influence: 1e3 });
+    let role = |name: &str| {
+        robot.capsules.iter().find(|c| c.name == name).map(|c| c.role).expect("a capsule")
+    };
+    for p in &all {
+        assert!(self_pairs().contains(&(role(&p.link), role(&p.obstacle))), "{p:?}");
+    }
+    let expected: usize = self_pairs()
+        .iter()
+        .map(|(m, a)| {
+            let count = |r: &LinkRole| robot.capsules.iter().filter(|c| c.role == *r).count();
+            count(m) * count(a)
+        })
+        .sum();
+    assert_eq!(all.len(), expected);
+    assert_eq!(min_distance(&robot, &pose, &scene).is_some(), expected > 0);
+}
