@@ -328,3 +328,38 @@ fn type_vii_follows_eq_12() {
         });
     }
 }
+
+/// `settings { frame root }` positions are the {b} ones plus the shoulder
+/// centre: both tasks decompose to the same configurations.
+#[test]
+fn root_frame_tasks_decompose_like_base_frame_ones() {
+    for name in ARMS {
+        let robot = load(name);
+        let mut rng = rng(47);
+        let (q0, _) = regular_q(&robot, &mut rng, 0.15);
+        let q1 = nearby(&robot, &q0, &mut rng, 0.3);
+        let g = state(&robot, &q1);
+        let s = robot.structure.shoulder_in_base_link;
+        let start: Vec<String> = q0.iter().map(|v| v.to_string()).collect();
+        let text = |frame: &str, pw: Vector3, ball: Vector3| {
+            format!(
+                "robot \"{}\"\nstart [{}]\nscene {{ ball = sphere at {} radius 0.01 }}\n\
+                 settings {{ frame {frame} }}\ntask t {{ action a {{ goal Pw Ow = ({}, {}) }} }}\n",
+                robot_path(name),
+                start.join(", "),
+                vector(&ball),
+                vector(&pw),
+                quat(&g.cpsa.ow)
+            )
+        };
+        let ball = Vector3::new(0.5, 0.5, 0.5);
+        let base = parse(&text("base", g.cpsa.pw, ball), None).expect("valid");
+        let root = parse(&text("root", g.cpsa.pw + s, ball + s), None).expect("valid");
+        let options = DecomposeOptions::default();
+        let (a, b) = (decompose(&robot, &base, &options), decompose(&robot, &root, &options));
+        let (Ok(a), Ok(b)) = (a, b) else { panic!("{name}: both should decompose") };
+        for (x, y) in a.actions[0].segments.iter().zip(&b.actions[0].segments) {
+            assert!((x.end - y.end).amax() < 1e-9, "{name}");
+        }
+    }
+}

@@ -17,7 +17,8 @@ use crate::robot::{LinkRole, Robot};
 /// The task's obstacles as parry shapes, positioned in {b}.
 ///
 /// Positions are read as {b} coordinates whatever `settings.frame` says:
-/// scenes written in the URDF root frame are not yet converted.
+/// scenes written in the URDF root frame must be moved first with
+/// [`crate::language::Task::in_base_frame`] (as `decompose` does).
 #[derive(Debug, Clone)]
 pub struct CollisionScene {
     bodies: Vec<Body>,

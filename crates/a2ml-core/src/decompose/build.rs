@@ -128,6 +128,9 @@ pub fn decompose(
     task: &Task,
     options: &DecomposeOptions,
 ) -> Result<Decomposition, DecomposeError> {
+    // Lines, axes and rotations are the same in the root frame and in {b};
+    // positions move by the shoulder centre.
+    let task = &task.in_base_frame(&robot.structure.shoulder_in_base_link);
     let start = start_configuration(robot, task)?;
     let order = order_with(task, &options.strips)?;
     let scene = CollisionScene::new(&task.scene);

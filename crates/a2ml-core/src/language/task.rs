@@ -427,3 +427,71 @@ pub struct Task {
     /// Actions in written order.
     pub actions: Vec<Action>,
 }
+
+impl Target {
+    /// The target with a position moved by `offset` (rotations and angles
+    /// are the same in frames that differ by a translation).
+    fn shifted(self, offset: &Vector3) -> Self {
+        match self {
+            Target::Position(p) => Target::Position(p + offset),
+            other => other,
+        }
+    }
+}
+
+fn shift_targets(targets: &mut [(Variable, Target)], offset: &Vector3) {
+    for (_, t) in targets {
+        *t = t.shifted(offset);
+    }
+}
+
+impl Task {
+    /// The task with every position (goals, start state, obstacles) in {b},
+    /// given S in the root link's frame: `settings { frame root }` tasks are
+    /// written in the root link's frame, which differs from {b} by the
+    /// translation to the shoulder centre only. A {b} task is returned as is.
+    pub fn in_base_frame(&self, shoulder_in_root: &Vector3) -> Task {
+        if self.settings.frame == PositionFrame::Base {
+            return self.clone();
+        }
+        let offset = -shoulder_in_root;
+        let mut task = self.clone();
+        task.settings.frame = PositionFrame::Base;
+        if let Some(Start::State(entries)) = &mut task.start {
+            shift_targets(entries, &offset);
+        }
+        for o in &mut task.scene {
+            match &mut o.shape {
+                Shape::Box { center, .. }
+                | Shape::Sphere { center, .. }
+                | Shape::Cylinder { center, .. } => *center += offset,
+                Shape::Capsule { a, b, .. } => {
+                    *a += offset;
+                    *b += offset;
+                }
+            }
+        }
+        for action in &mut task.actions {
+            match &mut action.body {
+                ActionBody::Constraints { goal, .. } => {
+                    if let Some(g) = goal {
+                        shift_targets(&mut g.primary.targets, &offset);
+                        if let Some(s) = &mut g.secondary {
+                            shift_targets(&mut s.targets, &offset);
+                        }
+                    }
+                }
+                ActionBody::Explicit(segments) => {
+                    for p in segments.iter_mut().flat_map(|s| &mut s.primitives) {
+                        if let PrimitiveConstraint::Goal(targets) = &mut p.constraint {
+                            for t in targets {
+                                *t = t.shifted(&offset);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        task
+    }
+}
