@@ -58,3 +58,11 @@ pub fn regular_q(robot: &Robot, rng: &mut StdRng, margin: Real) -> (JointVector,
         }
     }
 }
+
+/// A second configuration within `spread` of `q` per joint, inside the limits.
+pub fn nearby(robot: &Robot, q: &JointVector, rng: &mut StdRng, spread: Real) -> JointVector {
+    JointVector::from_fn(|i, _| {
+        let l = robot.joints[i].limits;
+        (q[i] + rng.random_range(-spread..spread)).clamp(l.lower + 1e-3, l.upper - 1e-3)
+    })
+}

@@ -1,14 +1,14 @@
 //! Opt1 and Opt2 recover constraints that a real configuration satisfies,
 //! keep the fixed goals exactly, and respect the joint limits.
 
-use crate::common::{load, regular_q, rng};
+use crate::common::{load, nearby, regular_q, rng};
 use a2ml::Robot;
 use a2ml::decompose::{ArmState, OptOptions, along_path, goal_error, opt1, opt2};
 use a2ml::kinematics::ik_cpsa;
 use a2ml::language::{
     Axis, BodyAxis, PathConstraint, PathFeature, PathItem, Space, Target, Variable,
 };
-use a2ml::math::{JointVector, Real, Vector3};
+use a2ml::math::{JointVector, Vector3};
 use rand::RngExt;
 
 const ARMS: [&str; 2] = ["coman_right_arm", "centauro_right_arm"];
@@ -19,19 +19,6 @@ fn state(robot: &Robot, q: &JointVector) -> ArmState {
 
 fn goals(s: &ArmState, vars: &[Variable]) -> Vec<(Variable, Target)> {
     vars.iter().map(|v| (*v, s.value(*v))).collect()
-}
-
-/// A second configuration near `q`, within limits.
-fn nearby(
-    robot: &Robot,
-    q: &JointVector,
-    rng: &mut rand::rngs::StdRng,
-    spread: Real,
-) -> JointVector {
-    JointVector::from_fn(|i, _| {
-        let l = robot.joints[i].limits;
-        (q[i] + rng.random_range(-spread..spread)).clamp(l.lower + 1e-3, l.upper - 1e-3)
-    })
 }
 
 fn assert_reaches(robot: &Robot, q: &JointVector, s: &ArmState) {

@@ -3,14 +3,13 @@
 //! constraints (DESIGN.md §4). Tasks are written from real configurations
 //! so that their goals are reachable.
 
-use crate::common::{load, regular_q, rng, robot_path};
+use crate::common::{load, nearby, regular_q, rng, robot_path};
 use a2ml::Robot;
 use a2ml::decompose::{
     ActionType, ArmState, DecomposeOptions, Decomposition, SegmentPattern, decompose, goal_error,
 };
 use a2ml::language::{PrimitiveConstraint, Space, Target, Variable, parse};
-use a2ml::math::{JointVector, Real, UnitQuaternion, Vector3, rotation_about};
-use rand::RngExt;
+use a2ml::math::{JointVector, UnitQuaternion, Vector3, rotation_about};
 
 const ARMS: [&str; 2] = ["coman_right_arm", "centauro_right_arm"];
 
@@ -25,18 +24,6 @@ fn quat(r: &a2ml::math::Rotation3) -> String {
 
 fn state(robot: &Robot, q: &JointVector) -> ArmState {
     ArmState::at(robot, q).expect("regular")
-}
-
-fn nearby(
-    robot: &Robot,
-    q: &JointVector,
-    rng: &mut rand::rngs::StdRng,
-    spread: Real,
-) -> JointVector {
-    JointVector::from_fn(|i, _| {
-        let l = robot.joints[i].limits;
-        (q[i] + rng.random_range(-spread..spread)).clamp(l.lower + 1e-3, l.upper - 1e-3)
-    })
 }
 
 /// Decomposes one action written with `body` from start `q0`.
