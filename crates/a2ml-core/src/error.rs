@@ -18,4 +18,7 @@ pub enum Error {
     /// A reference profile cannot be built.
     #[error(transparent)]
     Profile(#[from] crate::profile::ProfileError),
+    /// A trajectory cannot be built or joined.
+    #[error(transparent)]
+    Trajectory(#[from] crate::trajectory::TrajectoryError),
 }

@@ -16,6 +16,7 @@ pub mod math;
 pub mod names;
 pub mod profile;
 pub mod robot;
+pub mod trajectory;
 
 pub use error::Error;
 pub use kinematics::{CpsaState, HatState, KinematicsError};

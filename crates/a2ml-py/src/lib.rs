@@ -109,8 +109,8 @@ impl From<CoreError> for PyErr {
                 KinematicsError::NonFinite { .. } => PyValueError::new_err(message),
             },
             Error::Decompose(_) => DecomposeError::new_err(message),
-            // No profile API in Python yet; the base class until there is.
-            Error::Profile(_) => A2mlError::new_err(message),
+            // No profile or trajectory API in Python yet; the base class until there is.
+            Error::Profile(_) | Error::Trajectory(_) => A2mlError::new_err(message),
         }
     }
 }

@@ -1,0 +1,349 @@
+//! Sampled joint trajectories (time, q, q' per sample), their joining with +Tr blends and +Se
+//! (DESIGN.md §4, §5) and the checks run on the whole result: joint limits and clearance.
+//!
+//! Entry points: [`Trajectory::new`], [`join_sequential`], [`join_transitional`],
+//! [`check_limits`], [`min_clearance`]. Between samples q follows the cubic Hermite curve
+//! through the samples' q and q', so the two stay consistent.
+
+use crate::collision::{self, CollisionScene};
+use crate::kinematics::arm_pose;
+use crate::math::{DOF, JointVector, Real};
+use crate::profile::{self, JointSample, ProfileError, SequentialOptions, Transition};
+use crate::robot::Robot;
+
+#[cfg(test)]
+mod tests;
+
+/// Largest |q2(0) - q1(T1)| per joint accepted by [`join_sequential`] (rad).
+pub const SEQUENTIAL_GAP: Real = 1e-6;
+
+/// Why a trajectory cannot be built or joined.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TrajectoryError {
+    /// Times, positions and velocities differ in length.
+    #[error("{times} times, {positions} positions and {velocities} velocities")]
+    LengthMismatch {
+        /// Number of times.
+        times: usize,
+        /// Number of positions.
+        positions: usize,
+        /// Number of velocities.
+        velocities: usize,
+    },
+    /// There is no sample.
+    #[error("a trajectory needs at least one sample")]
+    Empty,
+    /// A time is not strictly after the one before.
+    #[error("time {time} s at sample {sample} does not follow {previous} s")]
+    TimesNotIncreasing {
+        /// Index of the offending sample.
+        sample: usize,
+        /// Its time (s).
+        time: Real,
+        /// The previous time (s).
+        previous: Real,
+    },
+    /// A time, position or velocity is NaN or infinite.
+    #[error("non-finite {what} at sample {sample}")]
+    NonFinite {
+        /// Which value: "time", "position" or "velocity".
+        what: &'static str,
+        /// Index of the sample.
+        sample: usize,
+    },
+    /// The resampling rate is not positive and finite.
+    #[error("invalid sampling rate {rate_hz} Hz")]
+    InvalidRate {
+        /// The rate asked for (Hz).
+        rate_hz: Real,
+    },
+    /// The segments cannot be joined (gap, not at rest, invalid overlap).
+    #[error(transparent)]
+    Join(#[from] ProfileError),
+}
+
+/// Joint positions and velocities sampled at strictly increasing times.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Trajectory {
+    times: Vec<Real>,
+    positions: Vec<JointVector>,
+    velocities: Vec<JointVector>,
+}
+
+impl Trajectory {
+    /// A trajectory from its samples: times (s), q (rad) and q' (rad/s).
+    ///
+    /// # Errors
+    /// [`TrajectoryError`] for different lengths, no sample, times not strictly increasing
+    /// or non-finite values.
+    pub fn new(
+        times: Vec<Real>,
+        positions: Vec<JointVector>,
+        velocities: Vec<JointVector>,
+    ) -> Result<Self, TrajectoryError> {
+        if times.len() != positions.len() || times.len() != velocities.len() {
+            return Err(TrajectoryError::LengthMismatch {
+                times: times.len(),
+                positions: positions.len(),
+                velocities: velocities.len(),
+            });
+        }
+        if times.is_empty() {
+            return Err(TrajectoryError::Empty);
+        }
+        for (sample, ((t, q), qd)) in times.iter().zip(&positions).zip(&velocities).enumerate() {
+            for (what, finite) in [
+                ("time", t.is_finite()),
+                ("position", q.iter().all(|x| x.is_finite())),
+                ("velocity", qd.iter().all(|x| x.is_finite())),
+            ] {
+                if !finite {
+                    return Err(TrajectoryError::NonFinite { what, sample });
+                }
+            }
+            if sample > 0 && *t <= times[sample - 1] {
+                let previous = times[sample - 1];
+                return Err(TrajectoryError::TimesNotIncreasing { sample, time: *t, previous });
+            }
+        }
+        Ok(Self { times, positions, velocities })
+    }
+
+    /// Samples `f` (time from 0, returning q and q') at the given times.
+    ///
+    /// # Errors
+    /// As [`Trajectory::new`].
+    pub fn from_fn(
+        times: Vec<Real>,
+        f: impl Fn(Real) -> JointSample,
+    ) -> Result<Self, TrajectoryError> {
+        let (positions, velocities) = times.iter().map(|&t| f(t)).unzip();
+        Self::new(times, positions, velocities)
+    }
+
+    /// Sample times (s).
+    pub fn times(&self) -> &[Real] {
+        &self.times
+    }
+
+    /// Joint positions per sample (rad).
+    pub fn positions(&self) -> &[JointVector] {
+        &self.positions
+    }
+
+    /// Joint velocities per sample (rad/s).
+    pub fn velocities(&self) -> &[JointVector] {
+        &self.velocities
+    }
+
+    /// Number of samples (at least one).
+    pub fn len(&self) -> usize {
+        self.times.len()
+    }
+
+    /// Always false: a trajectory has at least one sample.
+    pub fn is_empty(&self) -> bool {
+        self.times.is_empty()
+    }
+
+    /// Time of the first sample (s).
+    pub fn start(&self) -> Real {
+        self.times[0]
+    }
+
+    /// Time of the last sample (s).
+    pub fn end(&self) -> Real {
+        self.times[self.times.len() - 1]
+    }
+
+    /// Last time minus first time (s).
+    pub fn duration(&self) -> Real {
+        self.end() - self.start()
+    }
+
+    /// q and q' at time `t` (clamped to the trajectory's span) by cubic Hermite
+    /// interpolation of the neighbouring samples' q and q'.
+    pub fn sample(&self, t: Real) -> JointSample {
+        let t = t.clamp(self.start(), self.end());
+        // The interval [t_k, t_k+1] holding t.
+        let k = self.times.partition_point(|&s| s <= t).saturating_sub(1);
+        if k + 1 >= self.len() {
+            return (self.positions[k], self.velocities[k]);
+        }
+        let h = self.times[k + 1] - self.times[k];
+        let s = (t - self.times[k]) / h;
+        let (p0, p1) = (self.positions[k], self.positions[k + 1]);
+        let (m0, m1) = (self.velocities[k] * h, self.velocities[k + 1] * h);
+        let (s2, s3) = (s * s, s * s * s);
+        let q = p0 * (2.0 * s3 - 3.0 * s2 + 1.0)
+            + m0 * (s3 - 2.0 * s2 + s)
+            + p1 * (-2.0 * s3 + 3.0 * s2)
+            + m1 * (s3 - s2);
+        let dq = p0 * (6.0 * s2 - 6.0 * s)
+            + m0 * (3.0 * s2 - 4.0 * s + 1.0)
+            + p1 * (-6.0 * s2 + 6.0 * s)
+            + m1 * (3.0 * s2 - 2.0 * s);
+        (q, dq / h)
+    }
+
+    /// The trajectory sampled every 1/`rate_hz` s from its start, plus its end.
+    ///
+    /// # Errors
+    /// [`TrajectoryError::InvalidRate`] unless the rate is positive and finite.
+    pub fn resample(&self, rate_hz: Real) -> Result<Self, TrajectoryError> {
+        if !(rate_hz.is_finite() && rate_hz > 0.0) {
+            return Err(TrajectoryError::InvalidRate { rate_hz });
+        }
+        let step = 1.0 / rate_hz;
+        let count = (self.duration() / step).floor() as usize;
+        let mut times: Vec<Real> = (0..=count).map(|i| self.start() + i as Real * step).collect();
+        // Keep the end point exactly, dropping a grid point that rounds onto it.
+        times.retain(|&t| t < self.end() - 1e-9 * step);
+        times.push(self.end());
+        Self::from_fn(times, |t| self.sample(t))
+    }
+
+    /// `sample` in local time (0 at the first sample).
+    fn local(&self) -> impl Fn(Real) -> JointSample + '_ {
+        move |t| self.sample(self.start() + t)
+    }
+}
+
+/// Merges sorted time lists, dropping times within 1e-12 s of the one before.
+fn merge_times(mut times: Vec<Real>) -> Vec<Real> {
+    times.sort_by(Real::total_cmp);
+    times.dedup_by(|b, a| *b - *a <= 1e-12);
+    times
+}
+
+/// The sequential connection +Se: `second` starts where `first` ends, both at rest there.
+/// The result starts at `first`'s start; `second`'s samples follow, shifted in time.
+///
+/// # Errors
+/// [`TrajectoryError::Join`] with [`ProfileError::Discontinuous`] when q differs by more
+/// than [`SEQUENTIAL_GAP`] at the seam, or [`ProfileError::NotAtRest`] when either side moves
+/// faster than the default velocity tolerance.
+pub fn join_sequential(
+    first: &Trajectory,
+    second: &Trajectory,
+) -> Result<Trajectory, TrajectoryError> {
+    let options =
+        SequentialOptions { position_tolerance: SEQUENTIAL_GAP, ..SequentialOptions::default() };
+    let t1 = first.duration();
+    let joined = profile::join_sequential(first.local(), t1, second.local(), &options)?;
+    let times = first.times.iter().map(|t| t - first.start());
+    let later = second.times.iter().skip(1).map(|t| t - second.start() + t1);
+    let times: Vec<Real> = merge_times(times.chain(later).collect());
+    Trajectory::from_fn(times.iter().map(|t| t + first.start()).collect(), |t| {
+        joined(t - first.start())
+    })
+}
+
+/// The transitional connection +Tr (appendix A, eq. A.1): `second` starts `overlap` s before
+/// `first` ends and the two are blended over the overlap with β(t) = 0.5 cos(π (t - t2s) /
+/// (t1e - t2s)) + 0.5, q = β q1 + (1 - β) q2, q' = β q1' + (1 - β) q2' + β' (q1 - q2). The
+/// result lasts T1 + T2 - overlap and holds both inputs' sample times plus the seams.
+///
+/// # Errors
+/// [`TrajectoryError::Join`] with [`ProfileError::InvalidOverlap`] unless
+/// 0 ≤ overlap ≤ min(T1, T2).
+pub fn join_transitional(
+    first: &Trajectory,
+    second: &Trajectory,
+    overlap: Real,
+) -> Result<Trajectory, TrajectoryError> {
+    let transition = Transition::new(first.duration(), second.duration(), overlap)?;
+    let joined = profile::join_transitional(first.local(), second.local(), transition);
+    let t2s = transition.second_start();
+    let mut times: Vec<Real> = first.times.iter().map(|t| t - first.start()).collect();
+    times.extend(second.times.iter().map(|t| t - second.start() + t2s));
+    times.extend([t2s, transition.first_end()]);
+    let times = merge_times(times);
+    Trajectory::from_fn(times.iter().map(|t| t + first.start()).collect(), |t| {
+        joined(t - first.start())
+    })
+}
+
+/// Which limit a sample exceeds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LimitKind {
+    /// The joint's position range.
+    Position,
+    /// The joint's speed limit.
+    Velocity,
+}
+
+/// One joint outside one of its limits at one sample.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct LimitViolation {
+    /// Index of the sample.
+    pub sample: usize,
+    /// Index of the joint (0-6).
+    pub joint: usize,
+    /// The position (rad) or velocity (rad/s) at the sample.
+    pub value: Real,
+    /// The limit exceeded: the lower or upper bound, or ± the speed limit.
+    pub limit: Real,
+    /// Position or velocity.
+    pub kind: LimitKind,
+}
+
+/// Every sample and joint outside its position range or speed limit by more than
+/// `tolerance` (rad, rad/s), in sample then joint order.
+pub fn check_limits(
+    trajectory: &Trajectory,
+    robot: &Robot,
+    tolerance: Real,
+) -> Vec<LimitViolation> {
+    let (lower, upper, speed) = (robot.lower(), robot.upper(), robot.velocity_limits());
+    let mut out = Vec::new();
+    for (sample, (q, qd)) in trajectory.positions.iter().zip(&trajectory.velocities).enumerate() {
+        for joint in 0..DOF {
+            let mut flag = |value: Real, limit: Real, kind| {
+                out.push(LimitViolation { sample, joint, value, limit, kind });
+            };
+            if q[joint] < lower[joint] - tolerance {
+                flag(q[joint], lower[joint], LimitKind::Position);
+            } else if q[joint] > upper[joint] + tolerance {
+                flag(q[joint], upper[joint], LimitKind::Position);
+            }
+            if qd[joint].abs() > speed[joint] + tolerance {
+                flag(qd[joint], speed[joint].copysign(qd[joint]), LimitKind::Velocity);
+            }
+        }
+    }
+    out
+}
+
+/// The smallest clearance along a trajectory, checked at its samples.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Clearance {
+    /// Signed distance (m); negative is a penetration depth.
+    pub distance: Real,
+    /// Time of the worst sample (s).
+    pub time: Real,
+    /// The link capsule's name.
+    pub link: String,
+    /// The obstacle's name (or the other capsule's for self-collision).
+    pub obstacle: String,
+}
+
+/// The smallest [`collision::min_distance`] over the trajectory's samples, with when and
+/// between what it occurs; `None` when there is no pair to measure.
+pub fn min_clearance(
+    trajectory: &Trajectory,
+    robot: &Robot,
+    scene: &CollisionScene,
+) -> Option<Clearance> {
+    let mut best: Option<Clearance> = None;
+    for (&time, q) in trajectory.times.iter().zip(&trajectory.positions) {
+        let pose = arm_pose(robot, q);
+        if let Some((distance, link, obstacle)) = collision::min_distance(robot, &pose, scene) {
+            if best.as_ref().is_none_or(|b| distance < b.distance) {
+                best = Some(Clearance { distance, time, link, obstacle });
+            }
+        }
+    }
+    best
+}

@@ -1,0 +1,183 @@
+use super::*;
+use crate::language::{Obstacle, Shape};
+use crate::math::Vector3;
+
+fn robot() -> Robot {
+    Robot::from_urdf_file(concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/coman_right_arm.urdf"))
+        .expect("robot loads")
+}
+
+/// q(t) = c + a sin(w t) per joint, with its exact derivative, sampled every `dt` over [0, T].
+fn sine(c: JointVector, a: Real, w: Real, duration: Real, dt: Real) -> Trajectory {
+    let n = (duration / dt).round() as usize;
+    let times = (0..=n).map(|i| i as Real * duration / n as Real).collect();
+    Trajectory::from_fn(times, |t| {
+        (c + JointVector::repeat(a * (w * t).sin()), JointVector::repeat(a * w * (w * t).cos()))
+    })
+    .expect("valid")
+}
+
+/// A rest-to-rest move from `from` to `to` over [0, T] (smoothstep), sampled every `dt`.
+fn move_to(from: JointVector, to: JointVector, duration: Real, dt: Real) -> Trajectory {
+    let n = (duration / dt).round() as usize;
+    let times = (0..=n).map(|i| i as Real * duration / n as Real).collect();
+    Trajectory::from_fn(times, |t| {
+        let s = t / duration;
+        let (b, db) = (3.0 * s * s - 2.0 * s * s * s, (6.0 * s - 6.0 * s * s) / duration);
+        (from + (to - from) * b, (to - from) * db)
+    })
+    .expect("valid")
+}
+
+fn max_abs(v: JointVector) -> Real {
+    v.amax()
+}
+
+/// Left and right limits of q and q' at `t` agree to 1e-9.
+fn assert_continuous_at(tr: &Trajectory, t: Real) {
+    let eps = 1e-12;
+    let (left, right) = (tr.sample(t - eps), tr.sample(t + eps));
+    assert!(max_abs(left.0 - right.0) < 1e-9, "q jumps at {t}");
+    assert!(max_abs(left.1 - right.1) < 1e-9, "q' jumps at {t}");
+}
+
+#[test]
+fn constructor_validates() {
+    let q = JointVector::zeros();
+    assert!(matches!(
+        Trajectory::new(vec![0.0, 1.0], vec![q], vec![q, q]),
+        Err(TrajectoryError::LengthMismatch { .. })
+    ));
+    assert!(matches!(Trajectory::new(vec![], vec![], vec![]), Err(TrajectoryError::Empty)));
+    assert!(matches!(
+        Trajectory::new(vec![0.0, 0.0], vec![q, q], vec![q, q]),
+        Err(TrajectoryError::TimesNotIncreasing { sample: 1, .. })
+    ));
+    assert!(matches!(
+        Trajectory::new(vec![0.0, 1.0], vec![q, JointVector::repeat(Real::NAN)], vec![q, q]),
+        Err(TrajectoryError::NonFinite { what: "position", sample: 1 })
+    ));
+}
+
+#[test]
+fn hermite_hits_the_knots_and_is_c1() {
+    let tr = sine(JointVector::zeros(), 0.5, 2.0, 2.0, 0.1);
+    for (i, &t) in tr.times().iter().enumerate() {
+        let (q, qd) = tr.sample(t);
+        assert!(max_abs(q - tr.positions()[i]) < 1e-12);
+        assert!(max_abs(qd - tr.velocities()[i]) < 1e-12);
+    }
+    for &t in &tr.times()[1..tr.len() - 1] {
+        assert_continuous_at(&tr, t);
+    }
+    // q' is the derivative of q between knots, and close to the exact curve.
+    let (t, h) = (0.537, 1e-6);
+    let fd = (tr.sample(t + h).0 - tr.sample(t - h).0) / (2.0 * h);
+    assert!(max_abs(fd - tr.sample(t).1) < 1e-7);
+    assert!((tr.sample(t).0[0] - 0.5 * (2.0 * t).sin()).abs() < 1e-4);
+    // Clamped outside.
+    assert_eq!(tr.sample(-1.0), tr.sample(0.0));
+    assert_eq!(tr.sample(9.0), tr.sample(tr.end()));
+}
+
+#[test]
+fn resample_keeps_the_end_points() {
+    let tr = sine(JointVector::zeros(), 0.5, 2.0, 1.05, 0.05);
+    let r = tr.resample(10.0).expect("valid rate");
+    assert_eq!(r.start(), tr.start());
+    assert_eq!(r.end(), tr.end());
+    assert_eq!(r.len(), 12);
+    assert_eq!(r.positions()[r.len() - 1], tr.positions()[tr.len() - 1]);
+    assert!(matches!(tr.resample(0.0), Err(TrajectoryError::InvalidRate { .. })));
+}
+
+#[test]
+fn sequential_join_is_continuous_and_rejects_gaps() {
+    let (a, b, c) = (JointVector::zeros(), JointVector::repeat(0.3), JointVector::repeat(-0.2));
+    let first = move_to(a, b, 1.0, 0.1);
+    let second = move_to(b, c, 2.0, 0.1);
+    let joined = join_sequential(&first, &second).expect("continuous");
+    assert!((joined.duration() - 3.0).abs() < 1e-12);
+    assert_continuous_at(&joined, 1.0);
+    assert!(max_abs(joined.sample(3.0).0 - c) < 1e-12);
+
+    let gap = move_to(b + JointVector::repeat(1e-5), c, 2.0, 0.1);
+    assert!(matches!(
+        join_sequential(&first, &gap),
+        Err(TrajectoryError::Join(ProfileError::Discontinuous { .. }))
+    ));
+}
+
+#[test]
+fn transitional_join_is_c1_at_both_seams() {
+    let first = sine(JointVector::zeros(), 0.4, 1.5, 2.0, 0.1);
+    let second = sine(JointVector::repeat(0.2), 0.3, -2.0, 1.5, 0.1);
+    let overlap = 0.5;
+    let joined = join_transitional(&first, &second, overlap).expect("valid overlap");
+    assert!((joined.duration() - (2.0 + 1.5 - overlap)).abs() < 1e-12);
+    let (t2s, t1e) = (2.0 - overlap, 2.0);
+    for t in [t2s, t1e] {
+        assert_continuous_at(&joined, t);
+    }
+    // At the seams the blend equals the segment it hands over from / to.
+    let at_start = joined.sample(t2s);
+    assert!(max_abs(at_start.0 - first.sample(t2s).0) < 1e-12);
+    assert!(max_abs(at_start.1 - first.sample(t2s).1) < 1e-12);
+    let at_end = joined.sample(t1e);
+    assert!(max_abs(at_end.0 - second.sample(overlap).0) < 1e-12);
+    assert!(max_abs(at_end.1 - second.sample(overlap).1) < 1e-12);
+    assert!(matches!(
+        join_transitional(&first, &second, 3.0),
+        Err(TrajectoryError::Join(ProfileError::InvalidOverlap { .. }))
+    ));
+}
+
+#[test]
+fn limits_flag_violations_only() {
+    let robot = robot();
+    let mid = robot.middle();
+    let calm = move_to(mid, mid, 1.0, 0.1);
+    assert!(check_limits(&calm, &robot, 1e-9).is_empty());
+
+    let mut q = vec![mid; 3];
+    let mut qd = vec![JointVector::zeros(); 3];
+    q[1][2] = robot.upper()[2] + 0.1;
+    qd[2][4] = -2.0 * robot.velocity_limits()[4];
+    let bad = Trajectory::new(vec![0.0, 0.5, 1.0], q, qd).expect("valid");
+    let v = check_limits(&bad, &robot, 1e-9);
+    assert_eq!(v.len(), 2);
+    assert_eq!((v[0].sample, v[0].joint, v[0].kind), (1, 2, LimitKind::Position));
+    assert_eq!(v[0].limit, robot.upper()[2]);
+    assert_eq!((v[1].sample, v[1].joint, v[1].kind), (2, 4, LimitKind::Velocity));
+    assert_eq!(v[1].limit, -robot.velocity_limits()[4]);
+}
+
+#[test]
+fn min_clearance_is_the_worst_sample() {
+    let robot = robot();
+    let (a, b) = (robot.middle(), robot.middle() + JointVector::repeat(0.2));
+    let tr = move_to(a, b, 1.0, 0.1);
+    // A sphere 5 cm beyond the hand at the final pose.
+    let hand = arm_pose(&robot, &b).hand_frame().translation.vector;
+    let center: Vector3 = hand + hand.normalize() * 0.1;
+    let scene = CollisionScene::new(&[Obstacle {
+        name: "ball".into(),
+        shape: Shape::Sphere { center, radius: 0.05 },
+    }]);
+    let worst = min_clearance(&tr, &robot, &scene).expect("pairs exist");
+    let per_sample: Vec<Real> = tr
+        .positions()
+        .iter()
+        .map(|q| collision::min_distance(&robot, &arm_pose(&robot, q), &scene).expect("pairs").0)
+        .collect();
+    let smallest = per_sample.iter().copied().fold(Real::INFINITY, Real::min);
+    assert_eq!(worst.distance, smallest);
+    let i = tr.times().iter().position(|&t| t == worst.time).expect("a sample time");
+    let (d, link, obstacle) =
+        collision::min_distance(&robot, &arm_pose(&robot, &tr.positions()[i]), &scene)
+            .expect("pairs");
+    assert_eq!(
+        (worst.distance, worst.link.as_str(), worst.obstacle.as_str()),
+        (d, link.as_str(), obstacle.as_str())
+    );
+}
