@@ -96,17 +96,23 @@ impl Checker<'_> {
                 None
             }
             None => {
-                // Prefer a unit of the dimension expected here.
-                let help = did_you_mean(
-                    &unit.text,
-                    UNITS.iter().filter(|(_, d, _)| *d == dimension).map(|(n, ..)| *n),
-                )
-                .or_else(|| did_you_mean(&unit.text, UNITS.iter().map(|(n, ..)| *n)))
-                .map(|s| format!("did you mean `{s}`?"));
-                self.error_with_help(unit.span, format!("unknown unit `{}`", unit.text), help);
+                self.unknown_unit(unit, Some(dimension));
                 None
             }
         }
+    }
+
+    /// Reports an unknown unit, suggesting one of the expected dimension
+    /// first when it is known.
+    fn unknown_unit(&mut self, unit: &Name, dimension: Option<Dimension>) {
+        let names = |d: Option<Dimension>| {
+            UNITS.iter().filter(move |(_, u, _)| d.is_none_or(|d| *u == d)).map(|(n, ..)| *n)
+        };
+        let help = dimension
+            .and_then(|d| did_you_mean(&unit.text, names(Some(d))))
+            .or_else(|| did_you_mean(&unit.text, names(None)))
+            .map(|s| format!("did you mean `{s}`?"));
+        self.error_with_help(unit.span, format!("unknown unit `{}`", unit.text), help);
     }
 
     fn quantity(&mut self, q: &ast::Quantity, dimension: Dimension) -> Option<Real> {
@@ -397,9 +403,7 @@ impl Checker<'_> {
         };
         for unit in units.into_iter().flatten() {
             if !UNITS.iter().any(|(n, ..)| *n == unit.text) {
-                let help = did_you_mean(&unit.text, UNITS.iter().map(|(n, ..)| *n))
-                    .map(|s| format!("did you mean `{s}`?"));
-                self.error_with_help(unit.span, format!("unknown unit `{}`", unit.text), help);
+                self.unknown_unit(unit, None);
             }
         }
     }
