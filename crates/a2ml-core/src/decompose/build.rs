@@ -6,7 +6,7 @@
 //! that the next can be planned from there. Opt1 and Opt2 fill in the goals
 //! and path sizes the table leaves open.
 
-use super::opt::{ArmState, OptOptions, OptSolution, along_path, goal_error, opt1, opt2};
+use super::opt::{ArmState, OptOptions, OptSolution, along_path, opt1, opt2};
 use super::{
     ActionType, Classification, DecomposeError, SegmentPattern, StripsOptions, classify,
     order_with, segment_pattern,
@@ -284,10 +284,7 @@ impl Planner<'_> {
             ActionType::III => {
                 let ms1 =
                     self.complete(0, goal_space, goal_primitives(&g1), q, None, Fill::Hold)?;
-                let sol = opt1(self.robot, &g1, &g2, &ms1.end, Some(self.scene), opt)
-                    .map_err(|e| self.opt_failed(1, e))?;
-                record("Opt1", &sol);
-                let g3 = complement_targets(goal_space, &g1, &sol.state);
+                let g3 = self.opt1_complement(1, goal_space, &g1, &g2, &ms1.end, &mut record)?;
                 let mut prims = hold_primitives(&g1);
                 prims.extend(goal_primitives(&g3));
                 let ms2 = self.segment(1, goal_space, prims, ms1.end, None)?;
@@ -307,10 +304,7 @@ impl Planner<'_> {
                 // stay to where MS1 ended.
                 let end = self.state(&ms1.end, 0)?;
                 let rest = complement_targets(goal_space, &g1, &end);
-                let sol = opt1(self.robot, &g1, &rest, &ms1.end, Some(self.scene), opt)
-                    .map_err(|e| self.opt_failed(1, e))?;
-                record("Opt1", &sol);
-                let g4 = complement_targets(goal_space, &g1, &sol.state);
+                let g4 = self.opt1_complement(1, goal_space, &g1, &rest, &ms1.end, &mut record)?;
                 let mut prims = goal_primitives(&g1);
                 prims.extend(goal_primitives(&g4));
                 let ms2 = self.segment(1, goal_space, prims, ms1.end, None)?;
@@ -319,10 +313,7 @@ impl Planner<'_> {
             ActionType::VI | ActionType::VII => {
                 let path = path.ok_or_else(|| self.unreachable(0, "a path is needed".into()))?;
                 // The goal configuration: G1 with the rest of its space from Opt1.
-                let sol1 = opt1(self.robot, &g1, &g2, &q, Some(self.scene), opt)
-                    .map_err(|e| self.opt_failed(0, e))?;
-                record("Opt1", &sol1);
-                let g4 = complement_targets(goal_space, &g1, &sol1.state);
+                let g4 = self.opt1_complement(0, goal_space, &g1, &g2, &q, &mut record)?;
                 let mut whole = g1.clone();
                 whole.extend(g4.iter().copied());
                 let sol2 = opt2(self.robot, &whole, path, &q, Some(self.scene), opt)
@@ -342,6 +333,22 @@ impl Planner<'_> {
                 vec![ms1, ms2, ms3]
             }
         })
+    }
+
+    /// Opt1(G1, G2) from `q`: the goals of the rest of G1's space, recorded.
+    fn opt1_complement(
+        &self,
+        k: usize,
+        space: Space,
+        g1: &Targets,
+        g2: &Targets,
+        q: &JointVector,
+        record: &mut impl FnMut(&'static str, &OptSolution),
+    ) -> Result<Targets, DecomposeError> {
+        let sol = opt1(self.robot, g1, g2, q, Some(self.scene), &self.options.opt)
+            .map_err(|e| self.opt_failed(k, e))?;
+        record("Opt1", &sol);
+        Ok(complement_targets(space, g1, &sol.state))
     }
 
     /// A segment of `path` (sizes from Opt2 where given), the rest of its
@@ -595,13 +602,4 @@ fn complement_targets(space: Space, goals: &Targets, state: &ArmState) -> Target
         .filter(|v| !goals.iter().any(|(g, _)| g == v))
         .map(|v| (v, state.value(v)))
         .collect()
-}
-
-/// The error of `goals` at a planned segment's end (for reports and tests).
-pub fn segment_goal_error(
-    robot: &Robot,
-    segment: &PlannedSegment,
-    goals: &Targets,
-) -> Option<Real> {
-    ArmState::at(robot, &segment.end).ok().map(|s| goal_error(&s, goals))
 }

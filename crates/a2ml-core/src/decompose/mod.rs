@@ -14,7 +14,6 @@ mod strips;
 
 pub use build::{
     DecomposeOptions, Decomposition, FittsLaw, OptReport, PlannedAction, PlannedSegment, decompose,
-    segment_goal_error,
 };
 pub use classify::{
     ActionType, Classification, Combination, SegmentPattern, classify, segment_pattern,
