@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use serde_json::Value;
 
-use crate::{a2ml, robot_path, stderr, stdout};
+use crate::{a2ml, keys, robot_path, sorted, stderr, stdout};
 
 /// A file of the repository's `examples/`.
 fn example_path(name: &str) -> String {
@@ -32,18 +32,6 @@ fn temp_task(name: &str, text: &str) -> String {
     let path = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
     std::fs::write(&path, text).expect("temp file written");
     path.to_string_lossy().into_owned()
-}
-
-fn keys(value: &Value) -> Vec<&str> {
-    let mut keys: Vec<&str> =
-        value.as_object().expect("an object").keys().map(String::as_str).collect();
-    keys.sort_unstable();
-    keys
-}
-
-fn sorted(mut k: Vec<&str>) -> Vec<&str> {
-    k.sort_unstable();
-    k
 }
 
 const TARGET_KEYS: [&str; 8] =

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use serde_json::Value;
 
-use crate::{a2ml, robot_path, stderr, stdout};
+use crate::{a2ml, keys, robot_path, sorted, stderr, stdout};
 
 /// A regular iiwa14 configuration within the limits whose feasible swivel
 /// angles form proper intervals (not the whole circle).
@@ -23,18 +23,6 @@ fn robot_json(urdf: &str, args: &[&str]) -> Value {
 
 fn floats(value: &Value) -> Vec<f64> {
     value.as_array().expect("an array").iter().map(|v| v.as_f64().expect("a number")).collect()
-}
-
-fn keys(value: &Value) -> Vec<&str> {
-    let mut keys: Vec<&str> =
-        value.as_object().expect("an object").keys().map(String::as_str).collect();
-    keys.sort_unstable();
-    keys
-}
-
-fn sorted(mut k: Vec<&str>) -> Vec<&str> {
-    k.sort_unstable();
-    k
 }
 
 /// The line of `text` that starts (after indentation) with `label`.
