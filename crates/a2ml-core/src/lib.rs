@@ -16,6 +16,7 @@ pub mod math;
 pub mod names;
 pub mod profile;
 pub mod robot;
+pub mod solve;
 pub mod trajectory;
 
 pub use error::Error;

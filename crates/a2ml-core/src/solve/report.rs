@@ -1,0 +1,124 @@
+//! What planning produces: the joined trajectory and one report per segment, the data that
+//! the CLI's summary table, the MCAP annotations and the Python `Plan` are made from.
+
+use crate::decompose::{ActionType, SegmentPattern};
+use crate::language::{SolverChoice, Space, Variable};
+use crate::math::{Real, Vector3};
+use crate::trajectory::{Clearance, Trajectory};
+
+/// How close a goal must be reached.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Tolerance {
+    /// Position error (m), default 1 mm.
+    pub position: Real,
+    /// Rotation (geodesic) and angle error (rad), default 1°.
+    pub angle: Real,
+}
+
+impl Default for Tolerance {
+    fn default() -> Self {
+        Self { position: 1e-3, angle: 1.0_f64.to_radians() }
+    }
+}
+
+/// The final error of one state variable of a segment: distance (m) for Pw, geodesic angle
+/// for Ow and Os, absolute angle difference for θsw and θe (rad).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct VariableError {
+    /// The variable.
+    pub variable: Variable,
+    /// Its error at the segment's end (m or rad).
+    pub error: Real,
+    /// Whether it is within the tolerance.
+    pub within: bool,
+}
+
+/// Counters and timings of the velocity QP over one segment.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct QpStats {
+    /// Control steps taken.
+    pub steps: usize,
+    /// Steps where a bound or collision row was binding and Clarabel was called.
+    pub clarabel_steps: usize,
+    /// Mean wall time of a step (s): Jacobian, distances and the solve.
+    pub mean_step_time: Real,
+    /// Longest step (s).
+    pub worst_step_time: Real,
+    /// Median time of the steps that the weighted least-squares step solved (s).
+    pub median_fast_time: Real,
+    /// Median time of the steps that needed Clarabel (s); 0 when none did.
+    pub median_clarabel_time: Real,
+}
+
+/// One movement segment as solved.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SegmentReport {
+    /// The action's name.
+    pub action: String,
+    /// The action's index in `Task::actions`.
+    pub action_index: usize,
+    /// The segment's index within its action (0-based).
+    pub segment: usize,
+    /// The action's type (`None` for an action written as explicit segments).
+    pub action_type: Option<ActionType>,
+    /// CPSA or HAT.
+    pub space: Space,
+    /// 1, 2 or 3.
+    pub pattern: SegmentPattern,
+    /// The solver that produced the segment's motion (never `Auto`).
+    pub solver: SolverChoice,
+    /// The focus of interest: the variables of the segment's featured primitive.
+    pub focus: Vec<Variable>,
+    /// Start in the plan's time (s).
+    pub start: Real,
+    /// End in the plan's time (s), settling included.
+    pub end: Real,
+    /// The segment's own duration before joining (s).
+    pub duration: Real,
+    /// Time the solver ran past the reference's end to settle on the goal (s).
+    pub settle: Real,
+    /// Final error of every variable of the segment's space.
+    pub errors: Vec<VariableError>,
+    /// Largest deviation from a hard path over the segment (m or rad), if it has one.
+    pub path_error: Option<Real>,
+    /// Smallest clearance over the segment's samples, if there is any pair to measure.
+    pub clearance: Option<Clearance>,
+    /// Smallest distance of any joint to its position limits over the segment (rad).
+    pub limit_margin: Real,
+    /// Whether the solver stopped making progress short of the goal.
+    pub stalled: bool,
+    /// Whether every variable is within the tolerance at the end.
+    pub reached: bool,
+    /// QP counters and timings.
+    pub qp: QpStats,
+}
+
+/// A planned task: the whole joint trajectory at the output rate and what each segment did.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Plan {
+    /// The task's name.
+    pub task: String,
+    /// Joint names, in the order of q.
+    pub joint_names: Vec<String>,
+    /// Output rate (Hz).
+    pub rate: Real,
+    /// Time (s), q (rad), q' (rad/s), at `rate`, segments joined (+Tr within an action, +Se
+    /// between actions).
+    pub trajectory: Trajectory,
+    /// One report per segment, in time order.
+    pub segments: Vec<SegmentReport>,
+    /// The reference wrist path Pw(t) in {b} (m) at `rate`, in the plan's time: what the
+    /// segments were asked to follow, to compare with the planned one.
+    pub wrist_reference: Vec<(Real, Vector3)>,
+    /// The safety distance the solvers kept from obstacles (m).
+    pub safety_distance: Real,
+    /// Goals missed beyond tolerance and solver fallbacks, each naming the action and segment.
+    pub warnings: Vec<String>,
+}
+
+impl Plan {
+    /// Whether every segment reached its goals within tolerance.
+    pub fn reached(&self) -> bool {
+        self.segments.iter().all(|s| s.reached)
+    }
+}
