@@ -21,4 +21,7 @@ pub enum Error {
     /// A trajectory cannot be built or joined.
     #[error(transparent)]
     Trajectory(#[from] crate::trajectory::TrajectoryError),
+    /// A task cannot be planned.
+    #[error(transparent)]
+    Solve(#[from] crate::solve::SolveError),
 }

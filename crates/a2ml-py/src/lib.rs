@@ -14,6 +14,7 @@ use a2ml_core::kinematics::{self, CpsaState, HatState, KinematicsError};
 use a2ml_core::language::{Diagnostics, LanguageError};
 use a2ml_core::math::{DOF, JointVector, Matrix3, Real, Rotation3, Vector3};
 use a2ml_core::robot::{RobotError, RobotOptions};
+use a2ml_core::solve::SolveError;
 use numpy::ndarray::Array2;
 use numpy::{
     AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLikeDyn, PyUntypedArrayMethods,
@@ -111,6 +112,8 @@ impl From<CoreError> for PyErr {
             Error::Decompose(_) => DecomposeError::new_err(message),
             // No profile or trajectory API in Python yet; the base class until there is.
             Error::Profile(_) | Error::Trajectory(_) => A2mlError::new_err(message),
+            Error::Solve(SolveError::Decompose(_)) => DecomposeError::new_err(message),
+            Error::Solve(_) => A2mlError::new_err(message),
         }
     }
 }

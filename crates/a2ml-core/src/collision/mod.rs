@@ -53,6 +53,8 @@ pub struct PosedCapsule {
     pub name: String,
     /// Part of the arm carrying it.
     pub role: LinkRole,
+    /// The moving frame it is attached to.
+    pub frame: usize,
     /// Segment end in {b} (m).
     pub a: Vector3,
     /// Other segment end in {b} (m).
@@ -89,6 +91,11 @@ pub struct Proximity {
     pub on_obstacle: Vector3,
     /// Unit normal from the obstacle to the link, {b}.
     pub normal: Vector3,
+    /// The moving frame carrying the link capsule (for its point Jacobian).
+    pub link_frame: usize,
+    /// The moving frame carrying the other capsule of a self-collision pair;
+    /// `None` for a scene obstacle, which does not move.
+    pub obstacle_frame: Option<usize>,
 }
 
 /// The link capsules at `pose`, in {b}.
@@ -101,6 +108,7 @@ pub fn arm_capsules(robot: &Robot, pose: &ArmPose) -> Vec<PosedCapsule> {
             PosedCapsule {
                 name: c.name.clone(),
                 role: c.role,
+                frame: c.frame,
                 a: b_from_frame.transform_point(&c.a.into()).coords,
                 b: b_from_frame.transform_point(&c.b.into()).coords,
                 radius: c.radius,
@@ -186,6 +194,8 @@ struct Body {
     center: Vector3,
     /// Bounding sphere radius, margin included.
     bound: Real,
+    /// The moving frame of an arm capsule; `None` for an obstacle.
+    frame: Option<usize>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -226,6 +236,7 @@ impl Body {
                 margin: 0.0,
                 center: *center,
                 bound: 0.5 * size.norm(),
+                frame: None,
             },
             Shape::Sphere { center, radius } => Self {
                 name,
@@ -234,8 +245,9 @@ impl Body {
                 margin: 0.0,
                 center: *center,
                 bound: *radius,
+                frame: None,
             },
-            Shape::Capsule { a, b, radius } => Self::capsule(name, a, b, *radius),
+            Shape::Capsule { a, b, radius } => Self::capsule(name, a, b, *radius, None),
             Shape::Cylinder { center, radius, height } => Self {
                 name,
                 shape: Core::Cylinder(Cylinder::new(0.5 * height, *radius)),
@@ -247,11 +259,12 @@ impl Body {
                 margin: 0.0,
                 center: *center,
                 bound: radius.hypot(0.5 * height),
+                frame: None,
             },
         }
     }
 
-    fn capsule(name: String, a: &Vector3, b: &Vector3, radius: Real) -> Self {
+    fn capsule(name: String, a: &Vector3, b: &Vector3, radius: Real, frame: Option<usize>) -> Self {
         Self {
             name,
             shape: Core::Segment(Segment::new(to_parry(a), to_parry(b))),
@@ -259,11 +272,12 @@ impl Body {
             margin: radius,
             center: 0.5 * (a + b),
             bound: 0.5 * (b - a).norm() + radius,
+            frame,
         }
     }
 
     fn from_capsule(c: &PosedCapsule) -> Self {
-        Self::capsule(c.name.clone(), &c.a, &c.b, c.radius)
+        Self::capsule(c.name.clone(), &c.a, &c.b, c.radius, Some(c.frame))
     }
 }
 
@@ -318,6 +332,8 @@ fn proximity(link: &Body, obstacle: &Body, prediction: Real) -> Option<Proximity
         on_link: from_parry(contact.point2) - normal * link.margin,
         on_obstacle: from_parry(contact.point1) + normal * obstacle.margin,
         normal,
+        link_frame: link.frame.unwrap_or(0),
+        obstacle_frame: obstacle.frame,
     })
 }
 

@@ -8,7 +8,7 @@ fn v(x: Real, y: Real, z: Real) -> Vector3 {
 
 /// The link used throughout: a vertical capsule from the origin to z = 1, r = 0.1.
 fn link() -> Body {
-    Body::capsule("link".into(), &v(0.0, 0.0, 0.0), &v(0.0, 0.0, 1.0), 0.1)
+    Body::capsule("link".into(), &v(0.0, 0.0, 0.0), &v(0.0, 0.0, 1.0), 0.1, Some(1))
 }
 
 fn obstacle(shape: Shape) -> Body {

@@ -1,7 +1,11 @@
 //! Solving the segments of a decomposed task (DESIGN.md §5) and the plan they make.
 //!
-//! Entry points: [`Plan`] with one [`SegmentReport`] per segment.
+//! Entry points: [`plan`] (a task to a [`Plan`]: trajectory and one [`SegmentReport`] per
+//! segment) and [`qp::solve_segment`] (one segment with the velocity QP).
 
+mod plan;
+pub mod qp;
 mod report;
 
+pub use plan::{PlanOptions, Progress, SolveError, plan, plan_with_progress};
 pub use report::{Plan, QpStats, SegmentReport, Tolerance, VariableError};

@@ -79,8 +79,9 @@ pub struct SegmentReport {
     pub settle: Real,
     /// Final error of every variable of the segment's space.
     pub errors: Vec<VariableError>,
-    /// Largest deviation from a hard path over the segment (m or rad), if it has one.
-    pub path_error: Option<Real>,
+    /// Largest deviation of each path variable (paths and holds) from its reference over the
+    /// segment.
+    pub path_errors: Vec<VariableError>,
     /// Smallest clearance over the segment's samples, if there is any pair to measure.
     pub clearance: Option<Clearance>,
     /// Smallest distance of any joint to its position limits over the segment (rad).

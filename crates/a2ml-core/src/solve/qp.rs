@@ -1,0 +1,667 @@
+//! The velocity QP of paper eq. 7 (DESIGN.md §5): one segment, one small QP per control step.
+//!
+//! At each step the joint velocity q' minimises ½‖W(J q' - V)‖² + ½λ‖q'‖², J = J_cs or J_tr,
+//! V = reference velocity + gain × state error, subject to joint velocity bounds that brake
+//! before the position limits and one velocity-damper row per arm-obstacle pair inside the
+//! influence distance. J is square, so the unconstrained minimiser almost always tracks V
+//! exactly; when it already satisfies every bound and row it is the QP's solution, and only
+//! the steps where a constraint binds are handed to Clarabel. Clarabel is used here only.
+
+use std::time::Instant;
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettings, DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+
+use super::report::{QpStats, Tolerance};
+use crate::collision::{self, CollisionScene, DistanceOptions, Proximity};
+use crate::kinematics::{
+    ArmPose, KinematicsError, arm_pose, cpsa_jacobian, cpsa_state, hat_jacobian, hat_state,
+    point_jacobian,
+};
+use crate::language::{Space, Target, Variable};
+use crate::math::{DOF, JointVector, Matrix7, Real, Vector7, rotation_log, wrap_angle};
+use crate::profile::{Reference, Role, Sample, WeightOptions, WeightSchedule};
+use crate::robot::{LinkRole, Robot};
+use crate::trajectory::{Trajectory, TrajectoryError};
+
+/// Settings of the velocity QP.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct QpOptions {
+    /// Internal control step (s), default 2 ms.
+    pub step: Real,
+    /// Feedback gain on the state error (1/s), default 20.
+    pub gain: Real,
+    /// Weights of the task components.
+    pub weights: WeightOptions,
+    /// λ, the regularisation of ‖q'‖² that keeps the step bounded near singularities.
+    pub regularization: Real,
+    /// Joints stay this far inside their position limits (rad), default 1e-3.
+    pub limit_margin: Real,
+    /// Braking gain towards a position limit (1/s): q' ≤ k (q_max - margin - q), default 10.
+    pub limit_gain: Real,
+    /// Fraction of each joint's speed limit the QP may use, default 0.99 (the rest absorbs
+    /// interpolation between samples).
+    pub velocity_fraction: Real,
+    /// d_s, the distance kept from obstacles (m), default 0.01.
+    pub safety_distance: Real,
+    /// d_i, the influence distance where damper rows start (m), default 0.08.
+    pub influence: Real,
+    /// ξ, the damper's approach speed at the influence distance (m/s), default 0.5.
+    pub damper_speed: Real,
+    /// Longest time run past the reference's end to settle on the goal (s), default 1.
+    pub max_settle: Real,
+    /// Joint speed under which the arm counts as at rest (rad/s), default 5e-4.
+    pub rest_speed: Real,
+    /// When the goal counts as reached.
+    pub tolerance: Tolerance,
+}
+
+impl Default for QpOptions {
+    fn default() -> Self {
+        Self {
+            step: 0.002,
+            gain: 20.0,
+            weights: WeightOptions::default(),
+            regularization: 1e-6,
+            limit_margin: 1e-3,
+            limit_gain: 10.0,
+            velocity_fraction: 0.99,
+            safety_distance: 0.01,
+            influence: 0.08,
+            damper_speed: 0.5,
+            max_settle: 1.0,
+            rest_speed: 5e-4,
+            tolerance: Tolerance::default(),
+        }
+    }
+}
+
+/// Why a segment cannot be solved.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum QpError {
+    /// The settings are out of range.
+    #[error("invalid QP settings: {reason}")]
+    InvalidOptions {
+        /// What is wrong.
+        reason: &'static str,
+    },
+    /// The representation space is singular where the arm is.
+    #[error("at t = {time:.3} s: {source}")]
+    Singular {
+        /// Segment time (s).
+        time: Real,
+        /// The singularity.
+        source: KinematicsError,
+    },
+    /// Clarabel found no solution of a step's QP.
+    #[error("at t = {time:.3} s the QP has no solution (Clarabel: {status})")]
+    Unsolved {
+        /// Segment time (s).
+        time: Real,
+        /// Clarabel's status.
+        status: String,
+    },
+    /// The state where the arm stopped cannot be held.
+    #[error("the state where the arm stopped cannot be held: {reason}")]
+    Hold {
+        /// Why.
+        reason: String,
+    },
+    /// The samples do not make a trajectory (non-finite values).
+    #[error(transparent)]
+    Trajectory(#[from] TrajectoryError),
+}
+
+/// One state variable of a segment: what it follows and how it is weighted.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Component {
+    /// The variable.
+    pub variable: Variable,
+    /// Its reference over the segment.
+    pub reference: Reference,
+    /// Goal (scheduled weight) or path (constant weight).
+    pub role: Role,
+}
+
+/// A segment for the QP: the three components of one space, in [`Space::variables`] order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SegmentProblem {
+    /// CPSA or HAT.
+    pub space: Space,
+    /// One component per variable of the space, in its order.
+    pub components: [Component; 3],
+    /// The references' duration T (s).
+    pub duration: Real,
+}
+
+/// A solved segment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct QpSolution {
+    /// The internal steps: time from 0 (s), q, q'.
+    pub trajectory: Trajectory,
+    /// Final error of each component against its reference's end (m or rad).
+    pub errors: [Real; 3],
+    /// Largest error of each component against its reference over the segment (m or rad).
+    pub max_errors: [Real; 3],
+    /// Time run past T to settle (s).
+    pub settle: Real,
+    /// Every component within tolerance at the end.
+    pub reached: bool,
+    /// Progress stopped short of the goal.
+    pub stalled: bool,
+    /// Counters and timings.
+    pub stats: QpStats,
+}
+
+/// Solves `problem` from configuration `q0` among the obstacles of `scene`.
+///
+/// # Errors
+/// [`QpError`]: invalid settings, a singular representation along the way, or a step that
+/// Clarabel cannot solve.
+pub fn solve_segment(
+    robot: &Robot,
+    scene: &CollisionScene,
+    problem: &SegmentProblem,
+    q0: &JointVector,
+    options: &QpOptions,
+) -> Result<QpSolution, QpError> {
+    check_options(options)?;
+    let mut controller = Controller::new(robot, scene, problem, options);
+    let h = options.step;
+    let total = problem.duration;
+    // Steps land exactly on T; the settle phase continues on the same grid.
+    let steps = (total / h).ceil().max(1.0) as usize;
+    let h_ref = total / steps as Real;
+    let settle_steps = (options.max_settle / h_ref).ceil() as usize;
+    let window = ((0.2 / h_ref).ceil() as usize).max(1);
+
+    let mut times = Vec::with_capacity(steps + 1);
+    let mut positions = Vec::with_capacity(steps + 1);
+    let mut velocities = Vec::with_capacity(steps + 1);
+    let mut progress: Vec<Real> = Vec::new();
+    let mut max_errors = [0.0; 3];
+    let mut q = *q0;
+    let mut k = 0;
+    let (errors, stalled) = loop {
+        let t = k as Real * h_ref;
+        let step = controller.step(&q, t)?;
+        for (m, e) in max_errors.iter_mut().zip(step.errors) {
+            *m = Real::max(*m, e);
+        }
+        times.push(t);
+        positions.push(q);
+        velocities.push(step.velocity);
+        if k >= steps {
+            // Settling on the goal: stop at rest within tolerance, when progress stalls, or
+            // when the time is up.
+            let reached = controller.within(&step.errors);
+            let at_rest = step.velocity.amax() <= options.rest_speed;
+            let score = controller.score(&step.errors);
+            progress.push(score);
+            let n = progress.len();
+            let stuck = n > window && progress[n - 1 - window] - score <= 0.01 * score;
+            if (reached && at_rest) || stuck || k >= steps + settle_steps {
+                break (step.errors, !reached && stuck);
+            }
+        }
+        q += step.velocity * h_ref;
+        k += 1;
+    };
+    let mut end = times.len() - 1;
+    if velocities[end].amax() > options.rest_speed {
+        // Stopped short while still moving: hold the state reached until the arm is at rest,
+        // so the next action can start from rest.
+        let hold = controller.hold_problem(&q, options.max_settle.max(h_ref))?;
+        let mut brake = Controller::new(robot, scene, &hold, options);
+        let mut t = times[end];
+        for _ in 0..settle_steps.max(1) {
+            q += velocities[end] * h_ref;
+            t += h_ref;
+            let step = brake.step(&q, t - times[end])?;
+            times.push(t);
+            positions.push(q);
+            velocities.push(step.velocity);
+            end += 1;
+            if step.velocity.amax() <= options.rest_speed {
+                break;
+            }
+        }
+        controller.timing.merge(brake.timing);
+    }
+    let trajectory = Trajectory::new(times, positions, velocities)?;
+    let settle = (trajectory.duration() - total).max(0.0);
+    let reached = controller.within(&errors);
+    Ok(QpSolution {
+        trajectory,
+        errors,
+        max_errors,
+        settle,
+        reached,
+        stalled,
+        stats: controller.timing.stats(),
+    })
+}
+
+fn check_options(o: &QpOptions) -> Result<(), QpError> {
+    let positive = |x: Real| x.is_finite() && x > 0.0;
+    let checks = [
+        (positive(o.step), "the step must be positive"),
+        (positive(o.gain) && o.gain * o.step < 1.0, "the gain must be positive and below 1/step"),
+        (o.regularization.is_finite() && o.regularization >= 0.0, "negative regularisation"),
+        (o.limit_margin.is_finite() && o.limit_margin >= 0.0, "negative limit margin"),
+        (positive(o.limit_gain) && o.limit_gain * o.step <= 1.0, "limit gain out of range"),
+        (positive(o.velocity_fraction) && o.velocity_fraction <= 1.0, "velocity fraction"),
+        (o.safety_distance.is_finite() && o.safety_distance >= 0.0, "negative safety distance"),
+        (o.influence.is_finite() && o.influence > o.safety_distance, "influence <= safety"),
+        (positive(o.damper_speed), "the damper speed must be positive"),
+        (o.max_settle.is_finite() && o.max_settle >= 0.0, "negative settle time"),
+        (positive(o.rest_speed), "the rest speed must be positive"),
+    ];
+    match checks.iter().find(|(ok, _)| !ok) {
+        Some((_, reason)) => Err(QpError::InvalidOptions { reason }),
+        None => Ok(()),
+    }
+}
+
+/// The result of one control step.
+struct Step {
+    velocity: JointVector,
+    errors: [Real; 3],
+}
+
+/// Everything that stays the same over a segment's steps.
+struct Controller<'a> {
+    robot: &'a Robot,
+    scene: &'a CollisionScene,
+    problem: &'a SegmentProblem,
+    options: &'a QpOptions,
+    weights: WeightSchedule,
+    lower: JointVector,
+    upper: JointVector,
+    speed: JointVector,
+    /// Created at the first step where a constraint binds.
+    clarabel: Option<Clarabel>,
+    /// Rows reserved for damper constraints: every pair the distances can report.
+    pair_rows: usize,
+    timing: Timing,
+}
+
+impl<'a> Controller<'a> {
+    fn new(
+        robot: &'a Robot,
+        scene: &'a CollisionScene,
+        problem: &'a SegmentProblem,
+        options: &'a QpOptions,
+    ) -> Self {
+        Self {
+            robot,
+            scene,
+            problem,
+            options,
+            weights: WeightSchedule::new(problem.duration, options.weights),
+            lower: robot.lower(),
+            upper: robot.upper(),
+            speed: robot.velocity_limits() * options.velocity_fraction,
+            clarabel: None,
+            pair_rows: pair_count(robot, scene),
+            timing: Timing::default(),
+        }
+    }
+
+    fn step(&mut self, q: &JointVector, t: Real) -> Result<Step, QpError> {
+        let started = Instant::now();
+        let pose = arm_pose(self.robot, q);
+        let singular = |source| QpError::Singular { time: t, source };
+        let (jacobian, values) = self.measure(&pose).map_err(singular)?;
+        let (target, weights, errors) = self.task(t, &values);
+
+        // ½‖W(J x - V)‖² + ½λ‖x‖²: P = Jᵀ W² J + λ I, c = Jᵀ W² V.
+        let weighted = Matrix7::from_diagonal(&weights.component_mul(&weights)) * jacobian;
+        let p = jacobian.transpose() * weighted + Matrix7::identity() * self.options.regularization;
+        let c = weighted.transpose() * target;
+        let (lower, upper) = self.bounds(q);
+        let rows = self.damper_rows(&pose);
+
+        let unconstrained = p.cholesky().map(|ch| ch.solve(&c));
+        let feasible = |x: &Vector7| {
+            (0..DOF).all(|i| x[i] >= lower[i] - 1e-12 && x[i] <= upper[i] + 1e-12)
+                && rows.iter().all(|(a, b)| a.dot(x) <= b + 1e-12)
+        };
+        let (velocity, clarabel) = match unconstrained {
+            Some(x) if feasible(&x) => (x, false),
+            _ => (self.clarabel_solve(&p, &c, &lower, &upper, &rows, t)?, true),
+        };
+        self.timing.record(started.elapsed().as_secs_f64(), clarabel);
+        Ok(Step { velocity, errors })
+    }
+
+    /// The Jacobian of the segment's space and the current values of its variables.
+    fn measure(&self, pose: &ArmPose) -> Result<(Matrix7, [Target; 3]), KinematicsError> {
+        Ok(match self.problem.space {
+            Space::Cpsa => {
+                let s = cpsa_state(self.robot, pose)?;
+                let values =
+                    [Target::Position(s.pw), Target::Rotation(s.ow), Target::Angle(s.swivel)];
+                (cpsa_jacobian(self.robot, pose)?, values)
+            }
+            Space::Hat => {
+                let s = hat_state(pose)?;
+                let values = [
+                    Target::Rotation(s.shoulder_frame),
+                    Target::Angle(s.elbow_angle),
+                    Target::Rotation(s.ow),
+                ];
+                (hat_jacobian(pose)?, values)
+            }
+        })
+    }
+
+    /// V, the row weights and the component errors at t.
+    fn task(&self, t: Real, values: &[Target; 3]) -> (Vector7, Vector7, [Real; 3]) {
+        let mut target = Vector7::zeros();
+        let mut weights = Vector7::zeros();
+        let mut errors = [0.0; 3];
+        let gain = self.options.gain;
+        let mut row = 0;
+        for (slot, component) in self.problem.components.iter().enumerate() {
+            let w = self.weights.weight(component.role, t);
+            let sample = component.reference.sample(t);
+            let width = match (sample, values[slot]) {
+                (Sample::Position { value, velocity }, Target::Position(p)) => {
+                    let e = value - p;
+                    errors[slot] = e.norm();
+                    target.fixed_rows_mut::<3>(row).copy_from(&(velocity + e * gain));
+                    3
+                }
+                (Sample::Rotation { value, angular_velocity }, Target::Rotation(r)) => {
+                    // Spatial error: the rotation taking R to R_ref, R_ref Rᵀ, as a vector in {b}.
+                    let e = rotation_log(&(value * r.inverse()));
+                    errors[slot] = e.norm();
+                    target.fixed_rows_mut::<3>(row).copy_from(&(angular_velocity + e * gain));
+                    3
+                }
+                (Sample::Angle { value, rate }, Target::Angle(a)) => {
+                    let e = if component.variable == Variable::Swivel {
+                        wrap_angle(value - a)
+                    } else {
+                        value - a
+                    };
+                    errors[slot] = e.abs();
+                    target[row] = rate + e * gain;
+                    1
+                }
+                // References are built from the same variables as the values.
+                _ => {
+                    errors[slot] = Real::INFINITY;
+                    width(component.variable)
+                }
+            };
+            for i in row..row + width {
+                weights[i] = w;
+            }
+            row += width;
+        }
+        (target, weights, errors)
+    }
+
+    /// Velocity bounds: the speed limits, braking towards the position limits so that a joint
+    /// approaches `limit - margin` exponentially and never steps past it.
+    fn bounds(&self, q: &JointVector) -> (Vector7, Vector7) {
+        let (margin, k) = (self.options.limit_margin, self.options.limit_gain);
+        let mut lower = Vector7::zeros();
+        let mut upper = Vector7::zeros();
+        for i in 0..DOF {
+            // Inside the margin the joint may stay but not go further.
+            let room_up = (self.upper[i] - margin - q[i]).max(0.0);
+            let room_down = (q[i] - self.lower[i] - margin).max(0.0);
+            upper[i] = self.speed[i].min(k * room_up);
+            lower[i] = -self.speed[i].min(k * room_down);
+        }
+        (lower, upper)
+    }
+
+    /// One row a·x ≤ b per arm-obstacle pair inside the influence distance: the speed at
+    /// which the closest points approach, -nᵀ (J_link - J_other) x, is at most
+    /// ξ (d - d_s) / (d_i - d_s).
+    fn damper_rows(&self, pose: &ArmPose) -> Vec<(Vector7, Real)> {
+        let o = self.options;
+        let near = collision::distances(
+            self.robot,
+            pose,
+            self.scene,
+            &DistanceOptions { influence: o.influence },
+        );
+        near.iter()
+            .map(|p| {
+                let a = -(p.normal.transpose() * relative_jacobian(pose, p)).transpose();
+                let b = o.damper_speed * (p.distance - o.safety_distance)
+                    / (o.influence - o.safety_distance);
+                (a, b)
+            })
+            .collect()
+    }
+
+    fn clarabel_solve(
+        &mut self,
+        p: &Matrix7,
+        c: &Vector7,
+        lower: &Vector7,
+        upper: &Vector7,
+        rows: &[(Vector7, Real)],
+        t: Real,
+    ) -> Result<Vector7, QpError> {
+        let unsolved = |status| QpError::Unsolved { time: t, status };
+        let capacity = self.pair_rows.max(rows.len());
+        let mut solver = match self.clarabel.take() {
+            Some(s) if s.pair_rows >= capacity => s,
+            _ => Clarabel::new(capacity).map_err(unsolved)?,
+        };
+        let x = solver.solve(p, c, lower, upper, rows).map_err(unsolved);
+        self.clarabel = Some(solver);
+        x
+    }
+
+    /// A problem holding every variable at its value at `q` for `duration`.
+    fn hold_problem(&self, q: &JointVector, duration: Real) -> Result<SegmentProblem, QpError> {
+        let pose = arm_pose(self.robot, q);
+        let (_, values) =
+            self.measure(&pose).map_err(|source| QpError::Singular { time: 0.0, source })?;
+        let hold = |c: &Component, value: Target| -> Result<Component, QpError> {
+            let reference = Reference::hold(c.variable, value, duration)
+                .map_err(|e| QpError::Hold { reason: e.to_string() })?;
+            Ok(Component { variable: c.variable, reference, role: Role::Path })
+        };
+        let [a, b, c] = &self.problem.components;
+        Ok(SegmentProblem {
+            space: self.problem.space,
+            components: [hold(a, values[0])?, hold(b, values[1])?, hold(c, values[2])?],
+            duration,
+        })
+    }
+
+    fn within(&self, errors: &[Real; 3]) -> bool {
+        let tol = &self.options.tolerance;
+        self.problem
+            .components
+            .iter()
+            .zip(errors)
+            .all(|(c, e)| *e <= if c.variable == Variable::Pw { tol.position } else { tol.angle })
+    }
+
+    /// The errors in units of their tolerances, summed: one number that falls as the arm
+    /// approaches the goal.
+    fn score(&self, errors: &[Real; 3]) -> Real {
+        let tol = &self.options.tolerance;
+        self.problem
+            .components
+            .iter()
+            .zip(errors)
+            .map(|(c, e)| e / if c.variable == Variable::Pw { tol.position } else { tol.angle })
+            .sum()
+    }
+}
+
+/// Rows of a variable in its space's Jacobian: 3 for positions and rotations, 1 for angles.
+fn width(variable: Variable) -> usize {
+    match variable {
+        Variable::Swivel | Variable::Elbow => 1,
+        Variable::Pw | Variable::Ow | Variable::Os => 3,
+    }
+}
+
+/// J_p of the link's closest point, minus that of the other capsule's closest point when the
+/// other is a moving link (self-collision).
+fn relative_jacobian(pose: &ArmPose, p: &Proximity) -> crate::math::Jacobian3x7 {
+    let link = point_jacobian(pose, p.link_frame, &p.on_link);
+    match p.obstacle_frame {
+        Some(frame) => link - point_jacobian(pose, frame, &p.on_obstacle),
+        None => link,
+    }
+}
+
+/// How many pairs [`collision::distances`] can report for this robot and scene.
+fn pair_count(robot: &Robot, scene: &CollisionScene) -> usize {
+    let count = |role: LinkRole| robot.capsules.iter().filter(|c| c.role == role).count();
+    let moving = robot.capsules.iter().filter(|c| c.role != LinkRole::Base).count();
+    let own: usize = collision::self_pairs().iter().map(|(a, b)| count(*a) * count(*b)).sum();
+    moving * scene.len() + own
+}
+
+/// A Clarabel solver for the step QP, set up once with room for `pair_rows` damper rows and
+/// updated in place: 14 bound rows (x ≤ u, -x ≤ -l) then the damper rows, unused ones
+/// written as 0·x ≤ 1.
+struct Clarabel {
+    solver: DefaultSolver<Real>,
+    pair_rows: usize,
+    p_values: Vec<Real>,
+    q_values: Vec<Real>,
+    a_values: Vec<Real>,
+    b_values: Vec<Real>,
+}
+
+impl Clarabel {
+    fn new(pair_rows: usize) -> Result<Self, String> {
+        let m = 2 * DOF + pair_rows;
+        // P: the upper triangle of a dense 7x7, column by column.
+        let p_colptr: Vec<usize> = (0..=DOF).map(|j| j * (j + 1) / 2).collect();
+        let p_rows: Vec<usize> = (0..DOF).flat_map(|j| 0..=j).collect();
+        let p_values = vec![0.0; p_rows.len()];
+        let p = CscMatrix::new(DOF, DOF, p_colptr, p_rows, p_values.clone());
+        // A: column j holds +1 at row j, -1 at row 7 + j, and every damper row.
+        let per_column = 2 + pair_rows;
+        let a_colptr: Vec<usize> = (0..=DOF).map(|j| j * per_column).collect();
+        let a_rows: Vec<usize> =
+            (0..DOF).flat_map(|j| [j, DOF + j].into_iter().chain(2 * DOF..m)).collect();
+        let a_values: Vec<Real> = (0..DOF)
+            .flat_map(|_| [1.0, -1.0].into_iter().chain(std::iter::repeat_n(0.0, pair_rows)))
+            .collect();
+        let a = CscMatrix::new(m, DOF, a_colptr, a_rows, a_values.clone());
+        let b_values = vec![1.0; m];
+        let q_values = vec![0.0; DOF];
+        let cones = [SupportedConeT::NonnegativeConeT(m)];
+        let solver = DefaultSolver::new(&p, &q_values, &a, &b_values, &cones, settings())
+            .map_err(|e| e.to_string())?;
+        Ok(Self { solver, pair_rows, p_values, q_values, a_values, b_values })
+    }
+
+    fn solve(
+        &mut self,
+        p: &Matrix7,
+        c: &Vector7,
+        lower: &Vector7,
+        upper: &Vector7,
+        rows: &[(Vector7, Real)],
+    ) -> Result<Vector7, String> {
+        let mut k = 0;
+        for j in 0..DOF {
+            for i in 0..=j {
+                self.p_values[k] = p[(i, j)];
+                k += 1;
+            }
+            self.q_values[j] = -c[j];
+        }
+        let per_column = 2 + self.pair_rows;
+        for j in 0..DOF {
+            for r in 0..self.pair_rows {
+                self.a_values[j * per_column + 2 + r] = rows.get(r).map_or(0.0, |(a, _)| a[j]);
+            }
+            self.b_values[j] = upper[j];
+            self.b_values[DOF + j] = -lower[j];
+        }
+        for r in 0..self.pair_rows {
+            self.b_values[2 * DOF + r] = rows.get(r).map_or(1.0, |(_, b)| *b);
+        }
+        let update = |s: &mut DefaultSolver<Real>| -> Result<(), String> {
+            s.update_P(&self.p_values).map_err(|e| e.to_string())?;
+            s.update_q(&self.q_values).map_err(|e| e.to_string())?;
+            s.update_A(&self.a_values).map_err(|e| e.to_string())?;
+            s.update_b(&self.b_values).map_err(|e| e.to_string())
+        };
+        update(&mut self.solver)?;
+        self.solver.solve();
+        let solution = &self.solver.solution;
+        match solution.status {
+            SolverStatus::Solved | SolverStatus::AlmostSolved => {
+                Ok(Vector7::from_column_slice(&solution.x))
+            }
+            status => Err(format!("{status:?}")),
+        }
+    }
+}
+
+/// Clarabel tuned for a tiny dense QP solved thousands of times: no presolve or
+/// equilibration (they would forbid or distort the in-place updates), structural zeros kept
+/// so the sparsity pattern never changes, tolerances of 1e-8.
+fn settings() -> DefaultSettings<Real> {
+    DefaultSettingsBuilder::default()
+        .verbose(false)
+        .presolve_enable(false)
+        .equilibrate_enable(false)
+        .input_sparse_dropzeros(false)
+        .max_iter(100)
+        .build()
+        .unwrap_or_default()
+}
+
+/// Step timings, split by whether Clarabel was needed.
+#[derive(Default)]
+struct Timing {
+    fast: Vec<Real>,
+    clarabel: Vec<Real>,
+}
+
+impl Timing {
+    fn record(&mut self, seconds: Real, clarabel: bool) {
+        if clarabel { self.clarabel.push(seconds) } else { self.fast.push(seconds) }
+    }
+
+    fn merge(&mut self, other: Timing) {
+        self.fast.extend(other.fast);
+        self.clarabel.extend(other.clarabel);
+    }
+
+    fn stats(&self) -> QpStats {
+        let steps = self.fast.len() + self.clarabel.len();
+        let all = self.fast.iter().chain(&self.clarabel);
+        let total: Real = all.clone().sum();
+        QpStats {
+            steps,
+            clarabel_steps: self.clarabel.len(),
+            mean_step_time: if steps == 0 { 0.0 } else { total / steps as Real },
+            worst_step_time: all.fold(0.0, |a, b| a.max(*b)),
+            median_fast_time: median(&self.fast),
+            median_clarabel_time: median(&self.clarabel),
+        }
+    }
+}
+
+fn median(values: &[Real]) -> Real {
+    if values.is_empty() {
+        return 0.0;
+    }
+    let mut sorted = values.to_vec();
+    sorted.sort_by(Real::total_cmp);
+    sorted[sorted.len() / 2]
+}
