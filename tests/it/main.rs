@@ -8,6 +8,7 @@ mod ik;
 mod jacobians;
 mod language;
 mod opt;
+mod output;
 mod plan;
 mod profile;
 mod robots;

@@ -14,6 +14,7 @@ pub mod kinematics;
 pub mod language;
 pub mod math;
 pub mod names;
+pub mod output;
 pub mod profile;
 pub mod robot;
 pub mod solve;

@@ -1,0 +1,243 @@
+//! The MCAP recording: channels, attachments, metadata and the messages in time order. The
+//! mcap crate enters here only.
+
+use std::collections::BTreeMap;
+use std::io::{Seek, Write};
+
+use mcap::records::{MessageHeader, Metadata};
+use mcap::{Attachment, McapError, Writer};
+use serde::Serialize;
+
+use super::atomic::Failure;
+use super::messages::{self, StateSeries, Time};
+use super::schemas::{self, Schema};
+use super::{ARM_CAPSULE_RATE, topics};
+use crate::collision;
+use crate::kinematics::{arm_pose, cpsa_state, hat_state, link_poses};
+use crate::language::Task;
+use crate::math::{Real, Vector3};
+use crate::robot::Robot;
+use crate::solve::{Plan, SegmentReport};
+
+const JSON: &str = "json";
+const JSON_SCHEMA: &str = "jsonschema";
+
+impl From<McapError> for Failure {
+    fn from(e: McapError) -> Self {
+        match e {
+            McapError::Io(e) => Self::Io(e),
+            other => Self::Mcap(other.to_string()),
+        }
+    }
+}
+
+/// Plan time to MCAP time: nanoseconds from the plan's time 0 (or from its first sample, if
+/// that is earlier, since MCAP times are unsigned).
+#[derive(Debug, Clone, Copy)]
+struct Clock {
+    origin: Real,
+}
+
+impl Clock {
+    fn of(plan: &Plan) -> Self {
+        Self { origin: plan.trajectory.start().min(0.0) }
+    }
+
+    fn nanos(self, t: Real) -> u64 {
+        // `as` saturates: a time before the origin is 0.
+        ((t - self.origin) * 1e9).round() as u64
+    }
+}
+
+/// A channel and the sequence number of its next message.
+struct Topic {
+    id: u16,
+    sequence: u32,
+}
+
+struct Topics {
+    joint_states: Topic,
+    tf: Topic,
+    scene: Topic,
+    arm_capsules: Topic,
+    wrist_path: Topic,
+    state: Topic,
+    segments: Topic,
+}
+
+fn add_topic<W: Write + Seek>(
+    writer: &mut Writer<W>,
+    topic: &str,
+    schema: &Schema,
+) -> Result<Topic, Failure> {
+    let data = serde_json::to_vec(&schema.body)?;
+    let schema_id = writer.add_schema(schema.name, JSON_SCHEMA, &data)?;
+    let id = writer.add_channel(schema_id, topic, JSON, &BTreeMap::new())?;
+    Ok(Topic { id, sequence: 0 })
+}
+
+fn add_topics<W: Write + Seek>(writer: &mut Writer<W>) -> Result<Topics, Failure> {
+    let scene = schemas::scene_update();
+    Ok(Topics {
+        joint_states: add_topic(writer, topics::JOINT_STATES, &schemas::joint_state())?,
+        tf: add_topic(writer, topics::TF, &schemas::frame_transforms())?,
+        scene: add_topic(writer, topics::SCENE, &scene)?,
+        arm_capsules: add_topic(writer, topics::ARM_CAPSULES, &scene)?,
+        wrist_path: add_topic(writer, topics::WRIST_PATH, &scene)?,
+        state: add_topic(writer, topics::STATE, &schemas::state())?,
+        segments: add_topic(writer, topics::SEGMENTS, &schemas::segment())?,
+    })
+}
+
+/// Writes one JSON message with log time = publish time = `nanos`.
+fn publish<W: Write + Seek>(
+    writer: &mut Writer<W>,
+    topic: &mut Topic,
+    nanos: u64,
+    message: &impl Serialize,
+) -> Result<(), Failure> {
+    let data = serde_json::to_vec(message)?;
+    let header = MessageHeader {
+        channel_id: topic.id,
+        sequence: topic.sequence,
+        log_time: nanos,
+        publish_time: nanos,
+    };
+    topic.sequence = topic.sequence.wrapping_add(1);
+    writer.write_to_known_channel(&header, &data)?;
+    Ok(())
+}
+
+fn attach<W: Write + Seek>(
+    writer: &mut Writer<W>,
+    name: String,
+    media_type: &str,
+    data: &[u8],
+) -> Result<(), Failure> {
+    let attachment = Attachment {
+        log_time: 0,
+        create_time: 0,
+        name,
+        media_type: media_type.to_owned(),
+        data: data.into(),
+    };
+    writer.attach(&attachment)?;
+    Ok(())
+}
+
+fn metadata(robot: &Robot, task: &Task, plan: &Plan) -> Metadata {
+    let mut entries = BTreeMap::from([
+        ("task".to_owned(), task.name.clone()),
+        ("robot".to_owned(), robot.name.clone()),
+        ("a2ml_version".to_owned(), env!("CARGO_PKG_VERSION").to_owned()),
+        ("rate_hz".to_owned(), plan.rate.to_string()),
+        ("reached".to_owned(), plan.reached().to_string()),
+    ]);
+    if !plan.warnings.is_empty() {
+        entries.insert("warnings".to_owned(), plan.warnings.join("\n"));
+    }
+    Metadata { name: "a2ml".to_owned(), metadata: entries }
+}
+
+/// Every how many samples the arm's capsules are published, to stay at or below
+/// [`ARM_CAPSULE_RATE`].
+fn capsule_stride(rate: Real) -> usize {
+    let stride = (rate / ARM_CAPSULE_RATE).ceil();
+    if stride.is_finite() && stride >= 1.0 { stride as usize } else { 1 }
+}
+
+/// The segments in start order (stable for equal starts).
+fn by_start(segments: &[SegmentReport]) -> Vec<&SegmentReport> {
+    let mut sorted: Vec<&SegmentReport> = segments.iter().collect();
+    sorted.sort_by(|a, b| a.start.total_cmp(&b.start));
+    sorted
+}
+
+/// Writes the whole recording to `out`.
+pub(super) fn write<W: Write + Seek>(
+    out: W,
+    robot: &Robot,
+    task: &Task,
+    source: &str,
+    plan: &Plan,
+) -> Result<(), Failure> {
+    let mut writer = Writer::new(out)?;
+    attach(&mut writer, format!("{}.a2ml", task.name), "text/plain", source.as_bytes())?;
+    attach(&mut writer, format!("{}.urdf", robot.name), "application/xml", robot.urdf.as_bytes())?;
+    writer.write_metadata(&metadata(robot, task, plan))?;
+    let mut topics = add_topics(&mut writer)?;
+    write_static(&mut writer, &mut topics, robot, task, plan)?;
+    write_samples(&mut writer, &mut topics, robot, plan)?;
+    writer.finish()?;
+    Ok(())
+}
+
+/// The messages published once, at the first sample: the obstacles and the wrist paths.
+fn write_static<W: Write + Seek>(
+    writer: &mut Writer<W>,
+    topics: &mut Topics,
+    robot: &Robot,
+    task: &Task,
+    plan: &Plan,
+) -> Result<(), Failure> {
+    let nanos = Clock::of(plan).nanos(plan.trajectory.start());
+    let time = Time::from_nanos(nanos);
+    let scene = task.in_base_frame(&robot.structure.shoulder_in_base_link).scene;
+    publish(writer, &mut topics.scene, nanos, &messages::obstacles(time, &scene))?;
+    let planned: Vec<Vector3> =
+        plan.trajectory.positions().iter().map(|q| arm_pose(robot, q).wrist).collect();
+    let reference: Vec<Vector3> = plan.wrist_reference.iter().map(|(_, p)| *p).collect();
+    let paths = messages::wrist_paths(time, &planned, &reference);
+    publish(writer, &mut topics.wrist_path, nanos, &paths)
+}
+
+/// The per-sample messages, with each segment's record interleaved at its start time.
+fn write_samples<W: Write + Seek>(
+    writer: &mut Writer<W>,
+    topics: &mut Topics,
+    robot: &Robot,
+    plan: &Plan,
+) -> Result<(), Failure> {
+    let clock = Clock::of(plan);
+    let trajectory = &plan.trajectory;
+    let stride = capsule_stride(plan.rate);
+    let last = trajectory.len().saturating_sub(1);
+    let mut segments = by_start(&plan.segments).into_iter().peekable();
+    let mut series = StateSeries::default();
+    let samples =
+        trajectory.times().iter().zip(trajectory.positions()).zip(trajectory.velocities());
+    for (i, ((&t, q), qd)) in samples.enumerate() {
+        while let Some(segment) = segments.next_if(|s| s.start <= t) {
+            write_segment(writer, &mut topics.segments, clock, segment)?;
+        }
+        let nanos = clock.nanos(t);
+        let time = Time::from_nanos(nanos);
+        let pose = arm_pose(robot, q);
+        let joints = messages::joint_state(time, &plan.joint_names, q, qd);
+        publish(writer, &mut topics.joint_states, nanos, &joints)?;
+        let names = robot.links.iter().map(|l| l.name.as_str());
+        let tf = messages::frame_transforms(time, names.zip(link_poses(robot, &pose)));
+        publish(writer, &mut topics.tf, nanos, &tf)?;
+        let (cpsa, hat) = (cpsa_state(robot, &pose).ok(), hat_state(&pose).ok());
+        let state = messages::state(time, cpsa.as_ref(), hat.as_ref(), &mut series);
+        publish(writer, &mut topics.state, nanos, &state)?;
+        if i % stride == 0 || i == last {
+            let capsules = messages::arm_capsules(time, &collision::arm_capsules(robot, &pose));
+            publish(writer, &mut topics.arm_capsules, nanos, &capsules)?;
+        }
+    }
+    for segment in segments {
+        write_segment(writer, &mut topics.segments, clock, segment)?;
+    }
+    Ok(())
+}
+
+fn write_segment<W: Write + Seek>(
+    writer: &mut Writer<W>,
+    topic: &mut Topic,
+    clock: Clock,
+    segment: &SegmentReport,
+) -> Result<(), Failure> {
+    let nanos = clock.nanos(segment.start);
+    publish(writer, topic, nanos, &messages::segment(Time::from_nanos(nanos), segment))
+}

@@ -1,0 +1,113 @@
+//! Writing a [`Plan`] to files (DESIGN.md §6): an MCAP recording for Foxglove, a CSV table of
+//! the joint trajectory and the plan as JSON.
+//!
+//! Entry points: [`write_mcap`], [`write_csv`], [`write_json`]. Every writer goes through a
+//! temporary file beside the target, renamed on success and removed on failure, so a failed
+//! run never leaves a partial file. Positions are in {b}, times in the plan's seconds (MCAP:
+//! nanoseconds from the plan's time 0). mcap enters the crate here only.
+
+mod atomic;
+mod csv;
+mod json;
+mod mcap_file;
+mod messages;
+mod schemas;
+
+#[cfg(test)]
+mod tests;
+
+use std::path::Path;
+
+use crate::language::Task;
+use crate::math::Real;
+use crate::robot::Robot;
+use crate::solve::Plan;
+
+/// The MCAP channels [`write_mcap`] writes, all JSON-encoded with a JSON Schema.
+pub mod topics {
+    /// `a2ml.JointState` per sample: timestamp, joint names, positions (rad), velocities (rad/s).
+    pub const JOINT_STATES: &str = "/joint_states";
+    /// `foxglove.FrameTransforms` per sample: every link of the chain in frame "b".
+    pub const TF: &str = "/tf";
+    /// `foxglove.SceneUpdate` once at the start: the obstacles, in frame "b".
+    pub const SCENE: &str = "/scene";
+    /// `foxglove.SceneUpdate` per sample (at most [`super::ARM_CAPSULE_RATE`]): the arm's
+    /// capsules. A topic of its own, so that the obstacles published once stay the latest
+    /// `/scene` message that Foxglove replays after a seek.
+    pub const ARM_CAPSULES: &str = "/arm_capsules";
+    /// `foxglove.SceneUpdate` once: the planned and the reference wrist path Pw.
+    pub const WRIST_PATH: &str = "/wrist_path";
+    /// `a2ml.State` per sample: the CPSA and HAT states (null where singular).
+    pub const STATE: &str = "/a2ml/state";
+    /// `a2ml.Segment` at each segment's start: its [`crate::solve::SegmentReport`].
+    pub const SEGMENTS: &str = "/a2ml/segments";
+}
+
+/// Highest rate at which the arm's capsules are published (Hz): every sample up to this
+/// rate, every k-th sample above it.
+pub const ARM_CAPSULE_RATE: Real = 100.0;
+
+/// Why an output file could not be written. No partial file is left behind in any case.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OutputError {
+    /// The file system refused: a missing folder, no permission, a full disk.
+    #[error("cannot write {path}: {message}")]
+    Io {
+        /// The path as given.
+        path: String,
+        /// The OS message.
+        message: String,
+    },
+    /// The MCAP writer failed to encode a record.
+    #[error("cannot encode the MCAP file {path}: {message}")]
+    Mcap {
+        /// The path as given.
+        path: String,
+        /// The writer's message.
+        message: String,
+    },
+    /// A value could not be encoded as JSON.
+    #[error("cannot encode JSON for {path}: {message}")]
+    Json {
+        /// The path as given.
+        path: String,
+        /// The encoder's message.
+        message: String,
+    },
+}
+
+/// Writes the plan as an MCAP file for Foxglove: joint states, link transforms, the scene and
+/// the arm's capsules, the wrist path, the CPSA and HAT states and one record per segment
+/// (the channels are listed in [`topics`]), with the task `source` and the robot's URDF
+/// attached.
+///
+/// # Errors
+/// [`OutputError`] when the file cannot be written; the target is then left untouched.
+pub fn write_mcap(
+    path: &Path,
+    robot: &Robot,
+    task: &Task,
+    source: &str,
+    plan: &Plan,
+) -> Result<(), OutputError> {
+    atomic::write_atomically(path, |out| mcap_file::write(out, robot, task, source, plan))
+}
+
+/// Writes the joint trajectory as CSV: `t`, then `<joint>_pos` and `<joint>_vel` per joint,
+/// one row per sample (s, rad, rad/s), numbers in their shortest exact form.
+///
+/// # Errors
+/// [`OutputError::Io`] when the file cannot be written; the target is then left untouched.
+pub fn write_csv(path: &Path, robot: &Robot, plan: &Plan) -> Result<(), OutputError> {
+    atomic::write_atomically(path, |out| csv::write(out, robot, plan))
+}
+
+/// Writes the plan as pretty-printed JSON: the [`Plan`]'s fields (joint names, rate,
+/// trajectory, segment reports, wrist reference, warnings) with the a2ml version, the robot's
+/// name and the task's URDF path.
+///
+/// # Errors
+/// [`OutputError`] when the file cannot be written; the target is then left untouched.
+pub fn write_json(path: &Path, robot: &Robot, task: &Task, plan: &Plan) -> Result<(), OutputError> {
+    atomic::write_atomically(path, |out| json::write(out, robot, task, plan))
+}
