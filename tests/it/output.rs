@@ -524,6 +524,8 @@ fn a_failed_write_leaves_no_file() {
     let missing = dir.join("missing").join("plan.mcap");
     let err = write_mcap(&missing, &robot, &task, &source, &plan).expect_err("no folder");
     assert!(matches!(&err, OutputError::Io { path, .. } if path.ends_with("plan.mcap")), "{err}");
+    let a2ml_error: a2ml::Error = err.into();
+    assert!(a2ml_error.to_string().contains("plan.mcap"));
     // A folder in the way of the target: the rename fails after the whole file was written.
     let blocked = dir.join("plan.csv");
     fs::create_dir(&blocked).expect("folder");

@@ -24,4 +24,7 @@ pub enum Error {
     /// A task cannot be planned.
     #[error(transparent)]
     Solve(#[from] crate::solve::SolveError),
+    /// An output file cannot be written.
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
 }

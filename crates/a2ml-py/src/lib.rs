@@ -100,6 +100,7 @@ impl From<CoreError> for PyErr {
             Error::Robot(_) => UrdfError::new_err(message),
             Error::Language(LanguageError::Invalid(d)) => Python::attach(|py| parse_error(py, &d)),
             Error::Language(LanguageError::Io { .. }) => PyOSError::new_err(message),
+            Error::Output(_) => PyOSError::new_err(message),
             Error::Kinematics(k) => match k {
                 KinematicsError::Unreachable { .. } => UnreachableError::new_err(message),
                 KinematicsError::JointOutOfLimits { .. } => JointLimitError::new_err(message),
