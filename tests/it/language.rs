@@ -123,6 +123,10 @@ mod malformed {
     malformed!(strips_goal_unreachable, 4, 10, "fact `box_aside` is never true");
     malformed!(strips_init_without_goal, 3, 8, "also needs a `goal { .. }`");
     malformed!(bad_seed, 2, 17, "the seed is a non-negative whole number");
+    malformed!(unknown_contact, 5, 15, "unknown obstacle `box_aa`");
+    malformed!(contact_without_scene, 5, 15, "unknown obstacle `box_a`");
+    malformed!(duplicate_contact, 5, 22, "obstacle `box_a` is listed twice");
+    malformed!(contact_twice, 6, 13, "`contact` is given twice");
 }
 
 #[test]
@@ -232,6 +236,7 @@ fn did_you_mean_suggests_close_names() {
         ("unknown_solver", "rrt"),
         ("transition_bare_percent", "20 %"),
         ("strips_unknown_fact", "holding"),
+        ("unknown_contact", "box_a"),
     ];
     for (name, suggestion) in cases {
         let d = diagnostics(name);
@@ -241,6 +246,36 @@ fn did_you_mean_suggests_close_names() {
             "{name}: no suggestion of {suggestion}: {help:?}"
         );
     }
+}
+
+/// `contact` names obstacles of the scene, and the action's scene leaves
+/// them out; other actions keep the whole scene.
+#[test]
+fn contact_leaves_obstacles_out_of_the_action_scene() {
+    let robot = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("robots/coman_right_arm.urdf");
+    let text = format!(
+        "robot \"{}\"
+scene {{ a = sphere at [0.3, 0, 0] radius 0.05  b = sphere at [0.3, 0.2, 0] radius 0.05 }}
+task t {{
+  action push {{ contact {{ b }} path Pw line [0, 1, 0] 0.1 m, Ow hold, θsw hold }}
+  action both explicit {{ contact {{ b, a }} segment {{ (Pw Ow θsw).hold }} }}
+  action none {{ path θsw by 10 deg, Pw hold, Ow hold }}
+}}
+",
+        robot.display()
+    );
+    let task = parse(&text, None).unwrap_or_else(|e| panic!("{e}"));
+    let scene =
+        |i: usize| -> Vec<String> { task.action_scene(i).into_iter().map(|o| o.name).collect() };
+    assert_eq!(task.actions[0].contact, ["b"]);
+    assert_eq!(scene(0), ["a"]);
+    assert_eq!(task.actions[1].contact, ["b", "a"]);
+    assert!(scene(1).is_empty());
+    assert!(task.actions[2].contact.is_empty());
+    assert_eq!(scene(2), ["a", "b"]);
+    // Without a scene, the help says there is nothing to name.
+    let d = diagnostics("contact_without_scene");
+    assert!(d.items.iter().any(|i| i.help.as_deref().is_some_and(|h| h.contains("no obstacles"))));
 }
 
 mod no_panic {
@@ -266,6 +301,7 @@ mod no_panic {
         "pre",
         "add",
         "del",
+        "contact",
         "hold",
         "line",
         "about",

@@ -384,6 +384,7 @@ mod tests {
             pre: Vec::new(),
             add: Vec::new(),
             del: Vec::new(),
+            contact: Vec::new(),
             solver: None,
             body: ActionBody::Constraints { goal, path, duration: None },
             span: Span::default(),

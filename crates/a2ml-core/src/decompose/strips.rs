@@ -286,6 +286,7 @@ mod tests {
                     pre: strings(pre),
                     add: strings(add),
                     del: strings(del),
+                    contact: Vec::new(),
                     solver: None,
                     body: ActionBody::Constraints { goal: None, path: None, duration: None },
                     span: Span::default(),

@@ -253,10 +253,11 @@ pub enum SettingValue {
     Word(Name),
 }
 
-/// A set of STRIPS facts: `{ a, b }`.
+/// Names in braces, `{ a, b }`: STRIPS facts, or the obstacles of a
+/// `contact` statement.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Facts {
-    /// Fact names.
+    /// The names.
     pub names: Vec<Name>,
     /// The braces.
     pub span: Span,
@@ -292,6 +293,8 @@ pub struct Action {
     pub add: Vec<Facts>,
     /// Facts the action makes false.
     pub del: Vec<Facts>,
+    /// `contact` statements: obstacles the arm may touch.
+    pub contact: Vec<Facts>,
     /// `solver` statements.
     pub solver: Vec<Name>,
     /// Constraints or explicit segments.

@@ -4,7 +4,7 @@
 //! equals `parse_ast(text)`, comments included, and formatting is
 //! idempotent. What the tree does not keep is printed one fixed way: `>` for
 //! priority, no `+Se`, statements of an action in the order pre, add, del,
-//! goal, path, duration, solver. Comments go back beside the line of the
+//! contact, goal, path, duration, solver. Comments go back beside the line of the
 //! node they were written with, and move with it: a statement that canonical
 //! order moves past another takes its comments along, which is the one way
 //! the comments' order can change.
@@ -320,9 +320,12 @@ impl<'a> Printer<'a> {
             head.push_str(" explicit");
         }
         self.block(&head, action.span.start, action.braces, |p| {
-            for (keyword, list) in
-                [("pre", &action.pre), ("add", &action.add), ("del", &action.del)]
-            {
+            for (keyword, list) in [
+                ("pre", &action.pre),
+                ("add", &action.add),
+                ("del", &action.del),
+                ("contact", &action.contact),
+            ] {
                 for facts in list {
                     p.facts(keyword, facts);
                 }
@@ -653,8 +656,10 @@ task push_box_a_aside {
     solver qp
     pre { box_b_moved } add { box_a_aside }
     path Pw line [0, 1, 0] 0.12 m, Ow hold, θsw hold
+    contact { box_a,ball }
   }
   action type_vii explicit {
+    contact {bar} solver rrt
     segment 1.2 s { Os.path(about r, 24.7 deg) +Pa (θe Ow).goal(100 deg, rpy(-15.5, -11.5, -104.6) deg) }
     +Tr segment 1.0 s { (Pw Ow).goal([0.27, -0.10, 0.05], axes(f: [1,0,0], p: [0,1,0])) +Pa θsw.hold }
     +Tr segment 0.8 s { (Pw Ow).hold +Pa θsw.goal(63.2 deg) }
@@ -705,11 +710,14 @@ task push_box_a_aside {
   action push {
     pre { box_b_moved }
     add { box_a_aside }
+    contact { box_a, ball }
     path Pw line [0, 1, 0] 0.12 m, Ow hold, θsw hold
     solver qp
   }
 
   action type_vii explicit {
+    contact { bar }
+    solver rrt
     segment 1.2 s { Os.path(about r, 24.7 deg) +Pa (θe Ow).goal(100 deg, rpy(-15.5, -11.5, -104.6) deg) }
     +Tr segment 1 s { (Pw Ow).goal([0.27, -0.1, 0.05], axes(f: [1, 0, 0], p: [0, 1, 0])) +Pa θsw.hold }
     +Tr segment 0.8 s { (Pw Ow).hold +Pa θsw.goal(63.2 deg) }
@@ -767,6 +775,7 @@ task push_box_a_aside {   # the task
   +Se   # sequential
   action push {
     pre { box_b_moved } add { box_a_aside }
+    contact { box_a }   # pushed
     path Pw line [0, 1, 0] 0.12 m, Ow hold, θsw hold
     solver qp   # the solver
   }
@@ -844,6 +853,7 @@ task push_box_a_aside { # the task
   action push { # sequential
     pre { box_b_moved }
     add { box_a_aside }
+    contact { box_a } # pushed
     path Pw line [0, 1, 0] 0.12 m, Ow hold, θsw hold
     solver qp # the solver
   }
@@ -905,7 +915,7 @@ task push_box_a_aside { # the task
         file.items.iter().all(|item| {
             let Item::Task(task) = item else { return true };
             let actions_kept = task.actions.iter().all(|action| {
-                let mut spans = facts(&[&action.pre, &action.add, &action.del]);
+                let mut spans = facts(&[&action.pre, &action.add, &action.del, &action.contact]);
                 if let ActionBody::Constraints { goals, paths, durations } = &action.body {
                     spans.extend(goals.iter().map(|g| g.span));
                     spans.extend(paths.iter().map(|p| p.span));

@@ -146,6 +146,7 @@ fn describe(rule: &Rule) -> String {
         pre => "`pre`",
         add => "`add`",
         del => "`del`",
+        contact => "`contact`",
         segment => "`segment`",
         primitive => "a primitive like Pw.goal([..])",
         goal_call => "`.goal(values)`",
@@ -398,6 +399,7 @@ fn action(node: Node<'_>) -> ast::Action {
         pre: Vec::new(),
         add: Vec::new(),
         del: Vec::new(),
+        contact: Vec::new(),
         solver: Vec::new(),
         body: ast::ActionBody::Constraints {
             goals: Vec::new(),
@@ -443,6 +445,7 @@ fn common_statement(action: &mut ast::Action, node: Node<'_>) {
         Rule::pre => action.pre.push(facts(first_inner(node))),
         Rule::add => action.add.push(facts(first_inner(node))),
         Rule::del => action.del.push(facts(first_inner(node))),
+        Rule::contact => action.contact.push(facts(first_inner(node))),
         _ => action.solver.push(name(first_inner(node))),
     }
 }

@@ -307,6 +307,10 @@ pub struct Action {
     pub add: Vec<String>,
     /// STRIPS delete effects.
     pub del: Vec<String>,
+    /// Names of the scene's obstacles the arm may touch during this action
+    /// (the box a push moves): every collision check of the action leaves
+    /// them out. See [`Task::action_scene`].
+    pub contact: Vec<String>,
     /// Solver for this action, if chosen.
     pub solver: Option<SolverChoice>,
     /// Constraints or segments.
@@ -446,6 +450,17 @@ fn shift_targets(targets: &mut [(Variable, Target)], offset: &Vector3) {
 }
 
 impl Task {
+    /// The obstacles the arm must keep clear of during action `action` (an
+    /// index into [`Task::actions`]): the scene without the action's
+    /// `contact` obstacles, in the scene's order.
+    ///
+    /// # Panics
+    /// If `action` is not an index into [`Task::actions`].
+    pub fn action_scene(&self, action: usize) -> Vec<Obstacle> {
+        let contact = &self.actions[action].contact;
+        self.scene.iter().filter(|o| !contact.contains(&o.name)).cloned().collect()
+    }
+
     /// The task with every position (goals, start state, obstacles) in {b},
     /// given S in the root link's frame: `settings { frame root }` tasks are
     /// written in the root link's frame, which differs from {b} by the

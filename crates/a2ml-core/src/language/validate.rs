@@ -57,6 +57,9 @@ type Group = (Vec<Name>, Vec<Variable>, Option<PrimitiveConstraint>);
 struct Checker<'a> {
     errors: Vec<Diagnostic>,
     base_dir: Option<&'a Path>,
+    /// Every obstacle name the scene declares, shapes valid or not, so that
+    /// a bad shape is not reported again at each `contact` naming it.
+    obstacles: Vec<String>,
 }
 
 fn variable_names() -> impl Iterator<Item = &'static str> {
@@ -783,10 +786,45 @@ impl Checker<'_> {
         out
     }
 
+    /// The obstacles of an action's `contact`: declared in the scene, each
+    /// named once.
+    fn contact(&mut self, lists: &[ast::Facts]) -> Vec<String> {
+        if let Some(extra) = lists.get(1) {
+            self.error(extra.span, "`contact` is given twice; list every obstacle in one");
+        }
+        let mut out: Vec<String> = Vec::new();
+        for n in lists.iter().flat_map(|f| &f.names) {
+            if out.contains(&n.text) {
+                self.error(n.span, format!("obstacle `{}` is listed twice", n.text));
+                continue;
+            }
+            if !self.obstacles.contains(&n.text) {
+                let declared = self.obstacles.iter().map(String::as_str);
+                let help = did_you_mean(&n.text, declared)
+                    .map(|s| format!("did you mean `{s}`?"))
+                    .unwrap_or_else(|| match self.obstacles.as_slice() {
+                        [] => "the file declares no obstacles".to_owned(),
+                        names => format!("the scene declares {}", names.join(", ")),
+                    });
+                self.error_with_help(
+                    n.span,
+                    format!(
+                        "unknown obstacle `{}`: `contact` names obstacles of the scene",
+                        n.text
+                    ),
+                    Some(help),
+                );
+            }
+            out.push(n.text.clone());
+        }
+        out
+    }
+
     fn action(&mut self, a: &ast::Action) -> Option<Action> {
         let pre = self.facts(&a.pre, "pre");
         let add = self.facts(&a.add, "add");
         let del = self.facts(&a.del, "del");
+        let contact = self.contact(&a.contact);
         if let Some(extra) = a.solver.get(1) {
             self.error(extra.span, "`solver` is given twice");
         }
@@ -840,6 +878,7 @@ impl Checker<'_> {
             pre,
             add,
             del,
+            contact,
             solver,
             body,
             span: a.name.span,
@@ -1061,7 +1100,7 @@ impl Checker<'_> {
 /// Validates a parsed file. `base_dir` is the task file's folder, against
 /// which the robot path is resolved.
 pub(super) fn validate(file: &ast::File, base_dir: Option<&Path>) -> Result<Task, Vec<Diagnostic>> {
-    let mut c = Checker { errors: Vec::new(), base_dir };
+    let mut c = Checker { errors: Vec::new(), base_dir, obstacles: Vec::new() };
     let mut robot: Option<PathBuf> = None;
     let (mut seen_robot, mut start, mut scene, mut settings) = (false, None, Vec::new(), None);
     let mut tasks: Vec<&ast::Task> = Vec::new();
@@ -1092,6 +1131,7 @@ pub(super) fn validate(file: &ast::File, base_dir: Option<&Path>) -> Result<Task
                     c.error(s.span, "a file has one `scene`");
                 }
                 seen_scene = true;
+                c.obstacles.extend(s.obstacles.iter().map(|o| o.name.text.clone()));
                 scene.extend(c.scene(s));
             }
             ast::Item::Settings(s) => {
