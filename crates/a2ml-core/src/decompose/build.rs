@@ -133,10 +133,11 @@ pub fn decompose(
     let task = &task.in_base_frame(&robot.structure.shoulder_in_base_link);
     let start = start_configuration(robot, task)?;
     let order = order_with(task, &options.strips)?;
-    let scene = CollisionScene::new(&task.scene);
     let mut q = start;
     let mut actions = Vec::with_capacity(order.len());
     for index in order {
+        // The obstacles the action may touch (its `contact`) are no obstacles to it.
+        let scene = CollisionScene::new(&task.action_scene(index));
         let planned = Planner { robot, task, options, scene: &scene, index }.action(q)?;
         if let Some(last) = planned.segments.last() {
             q = last.end;
