@@ -5,8 +5,9 @@
 //! (Opt1) or from a path and its size (Opt2); the free ones are searched by
 //! Levenberg-Marquardt with multistart, every candidate checked through the
 //! CPSA <-> HAT mapping and IK within the joint limits, the end state kept
-//! clear of the scene by [`OptOptions::clearance`]. A one-dimensional search over θsw
-//! first samples the closed-form feasible swivel intervals.
+//! clear of the scene by [`OptOptions::clearance`] and off the limits by
+//! [`OptOptions::limit_margin`]. A one-dimensional search over θsw first
+//! samples the closed-form feasible swivel intervals.
 
 use crate::collision::{CollisionScene, min_distance};
 use crate::kinematics::{
@@ -129,6 +130,11 @@ pub struct OptOptions {
     /// Smallest distance (m) every arm capsule keeps from the obstacles and
     /// from the other links at the end state.
     pub clearance: Real,
+    /// Smallest distance (rad) every joint keeps from its limits at the end
+    /// state. An optimum often lies on a limit (a path as long as the arm
+    /// allows); a solver that keeps its own margin from the limits, as the
+    /// velocity QP does, could not reach it.
+    pub limit_margin: Real,
 }
 
 impl Default for OptOptions {
@@ -141,6 +147,7 @@ impl Default for OptOptions {
             max_path_size: 1.0,
             swivel_samples: 72,
             clearance: 0.01,
+            limit_margin: 1e-3,
         }
     }
 }
@@ -302,7 +309,11 @@ impl Search<'_> {
     fn evaluate(&mut self, x: &[Real]) -> Option<(ArmState, JointVector)> {
         self.evaluations += 1;
         let end = ArmState::from_space(self.robot, self.space, &self.values(x, 1.0))?;
-        let q = ik_cpsa(self.robot, &end.cpsa, Some(&self.start_q)).ok()?.first().copied()?;
+        let margin = self.options.limit_margin;
+        let q = ik_cpsa(self.robot, &end.cpsa, Some(&self.start_q))
+            .ok()?
+            .into_iter()
+            .find(|q| self.robot.within_limits(q, -margin))?;
         if !self.clear(&q) {
             return None;
         }
