@@ -1,12 +1,15 @@
-//! Decomposition: the STRIPS order of the paper's push-box task (§6.4) and
-//! the classification of actions into the seven types (fig. 3).
+//! Decomposition: the STRIPS order of the paper's push-box task (§6.4), the
+//! classification of actions into the seven types (fig. 3), and every
+//! shipped example decomposed whole.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
+use a2ml::Robot;
 use a2ml::decompose::{
-    ActionType, Combination, DecomposeError, SegmentPattern, classify, order, segment_pattern,
+    ActionType, Combination, DecomposeError, DecomposeOptions, Decomposition, SegmentPattern,
+    classify, decompose, order, segment_pattern,
 };
-use a2ml::language::{ActionBody, Space, Task, parse};
+use a2ml::language::{ActionBody, Space, Task, load, parse};
 
 /// Parses a task whose robot path is relative to the repository root.
 fn task(text: &str) -> Task {
@@ -313,4 +316,123 @@ fn explicit_actions_are_not_classified_and_segments_have_patterns() {
         segments.iter().map(|s| segment_pattern(&s.primitives)).collect();
     use SegmentPattern::*;
     assert_eq!(patterns, [Some(Mixed), Some(Mixed), Some(Goal), Some(Path)]);
+}
+
+/// Decomposes a file of `examples/` with the default options.
+fn decompose_example(path: &Path) -> (Robot, Task, Result<Decomposition, DecomposeError>) {
+    let task = load(path).unwrap_or_else(|e| panic!("{} does not validate:\n{e}", path.display()));
+    let robot = Robot::from_urdf_file(&task.robot).expect("the example's robot loads");
+    let decomposition = decompose(&robot, &task, &DecomposeOptions::default());
+    (robot, task, decomposition)
+}
+
+fn example(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples").join(name)
+}
+
+/// Every shipped example decomposes with the default options, but for a
+/// file without `start` (construct_minimal.a2ml), which is valid yet has
+/// nowhere to plan from.
+#[test]
+fn every_example_decomposes() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples");
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
+        .expect("examples folder")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "a2ml"))
+        .collect();
+    paths.sort();
+    assert!(paths.len() >= 20, "only {} examples", paths.len());
+    let mut without_start = Vec::new();
+    for path in &paths {
+        let (_, task, decomposition) = decompose_example(path);
+        match (&task.start, decomposition) {
+            (Some(_), Ok(d)) => {
+                assert_eq!(d.actions.len(), task.actions.len(), "{}", path.display())
+            }
+            (Some(_), Err(e)) => panic!("{} does not decompose: {e}", path.display()),
+            (None, result) => {
+                assert!(
+                    matches!(result, Err(DecomposeError::NoStart { .. })),
+                    "{}",
+                    path.display()
+                );
+                without_start.push(path.file_name().expect("a file"));
+            }
+        }
+    }
+    assert_eq!(without_start, ["construct_minimal.a2ml"]);
+}
+
+/// §6.4 on both arms: the same seven actions in the same order, of the
+/// paper's types, each pushing hand against the box it names in `contact`.
+#[test]
+fn push_box_examples_run_the_papers_seven_actions_on_both_arms() {
+    use ActionType::*;
+    for name in ["push_box_aside_coman.a2ml", "push_box_aside_centauro.a2ml"] {
+        let (_, task, decomposition) = decompose_example(&example(name));
+        let d = decomposition.unwrap_or_else(|e| panic!("{name}: {e}"));
+        let names: Vec<&str> = d.actions.iter().map(|a| a.name.as_str()).collect();
+        assert_eq!(names, PAPER_ORDER, "{name}");
+        let types: Vec<ActionType> = d
+            .actions
+            .iter()
+            .map(|a| a.classification.as_ref().expect("constraints").action_type)
+            .collect();
+        assert_eq!(types, [III, IV, V, II, I, V, I], "{name}");
+        let contact = |action: &str| -> Vec<String> {
+            task.actions.iter().find(|a| a.name == action).expect("action").contact.clone()
+        };
+        assert_eq!(contact("move_b"), ["box_b"], "{name}");
+        assert_eq!(contact("approach_a"), ["box_a", "box_b"], "{name}");
+        assert_eq!(contact("push_a"), ["box_a", "box_b"], "{name}");
+    }
+}
+
+/// An obstacle at the goal: Opt1 finds no end state clear of it, unless
+/// the action names it in `contact`.
+#[test]
+fn contact_lets_an_action_reach_into_an_obstacle() {
+    let text = |contact: &str| {
+        file(&format!(
+            "action touch {{\n{contact}\n\
+             goal Pw = [0.2, -0.1, -0.2] > Os = axes(r: [0, 0, -1], l: [0, 1, 0])\n}}"
+        ))
+        .replace("task t", "scene { ball = sphere at [0.2, -0.1, -0.2] radius 0.05 }\ntask t")
+    };
+    let robot = Robot::from_urdf_file(crate::common::robot_path("coman_right_arm")).expect("robot");
+    let options = DecomposeOptions::default();
+    let blocked = decompose(&robot, &task(&text("")), &options);
+    assert!(matches!(blocked, Err(DecomposeError::Unreachable { .. })), "{blocked:?}");
+    let touching = decompose(&robot, &task(&text("contact { ball }")), &options);
+    let d = touching.unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(d.actions[0].classification.as_ref().map(|c| c.action_type), Some(ActionType::III));
+}
+
+/// Opt2 of a hard path sizes it as far as the arm allows, which ends on a
+/// joint limit; the end state keeps `OptOptions::limit_margin` from it.
+#[test]
+fn opt_end_states_keep_the_limit_margin() {
+    let path = example("push_box_aside_coman.a2ml");
+    let (robot, task, _) = decompose_example(&path);
+    let end_of_retract = |margin: f64| {
+        let mut options = DecomposeOptions::default();
+        options.opt.limit_margin = margin;
+        let d = decompose(&robot, &task, &options).expect("decomposes");
+        let retract = d.actions.iter().find(|a| a.name == "retract").expect("retract");
+        assert_eq!(retract.optimisations[0].solver, "Opt2");
+        retract.segments[0].end
+    };
+    let room = |q: &a2ml::math::JointVector| {
+        (0..q.len())
+            .map(|i| {
+                let l = &robot.joints[i].limits;
+                (q[i] - l.lower).min(l.upper - q[i])
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    assert!(room(&end_of_retract(0.0)) < 1e-6, "without a margin the optimum is on a limit");
+    let default = DecomposeOptions::default().opt.limit_margin;
+    assert!(default > 0.0);
+    assert!(room(&end_of_retract(default)) >= default - 1e-9);
 }
