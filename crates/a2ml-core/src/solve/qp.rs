@@ -23,7 +23,7 @@ use crate::kinematics::{
 use crate::language::{Space, Target, Variable};
 use crate::math::{DOF, JointVector, Matrix7, Real, Vector7, rotation_log, wrap_angle};
 use crate::profile::{Reference, Role, Sample, WeightOptions, WeightSchedule};
-use crate::robot::{LinkRole, Robot};
+use crate::robot::Robot;
 use crate::trajectory::{Trajectory, TrajectoryError};
 
 /// Settings of the velocity QP.
@@ -283,8 +283,6 @@ struct Controller<'a> {
     speed: JointVector,
     /// Created at the first step where a constraint binds.
     clarabel: Option<Clarabel>,
-    /// Rows reserved for damper constraints: every pair the distances can report.
-    pair_rows: usize,
     timing: Timing,
 }
 
@@ -305,7 +303,6 @@ impl<'a> Controller<'a> {
             upper: robot.upper(),
             speed: robot.velocity_limits() * options.velocity_fraction,
             clarabel: None,
-            pair_rows: pair_count(robot, scene),
             timing: Timing::default(),
         }
     }
@@ -453,10 +450,18 @@ impl<'a> Controller<'a> {
         t: Real,
     ) -> Result<Vector7, QpError> {
         let unsolved = |status| QpError::Unsolved { time: t, status };
-        let capacity = self.pair_rows.max(rows.len());
+        // Room for the rows present now, grown by doubling: far fewer rows than pairs are
+        // ever near at once, and the interior-point cost grows with the rows.
         let mut solver = match self.clarabel.take() {
-            Some(s) if s.pair_rows >= capacity => s,
-            _ => Clarabel::new(capacity).map_err(unsolved)?,
+            Some(s) if s.pair_rows >= rows.len() => s,
+            previous => {
+                let room = previous.map_or(2, |s| s.pair_rows).max(1);
+                let mut capacity = room;
+                while capacity < rows.len() {
+                    capacity *= 2;
+                }
+                Clarabel::new(capacity).map_err(unsolved)?
+            }
         };
         let x = solver.solve(p, c, lower, upper, rows).map_err(unsolved);
         self.clarabel = Some(solver);
@@ -521,15 +526,7 @@ fn relative_jacobian(pose: &ArmPose, p: &Proximity) -> crate::math::Jacobian3x7 
     }
 }
 
-/// How many pairs [`collision::distances`] can report for this robot and scene.
-fn pair_count(robot: &Robot, scene: &CollisionScene) -> usize {
-    let count = |role: LinkRole| robot.capsules.iter().filter(|c| c.role == role).count();
-    let moving = robot.capsules.iter().filter(|c| c.role != LinkRole::Base).count();
-    let own: usize = collision::self_pairs().iter().map(|(a, b)| count(*a) * count(*b)).sum();
-    moving * scene.len() + own
-}
-
-/// A Clarabel solver for the step QP, set up once with room for `pair_rows` damper rows and
+/// A Clarabel solver for the step QP, set up with room for `pair_rows` damper rows and
 /// updated in place: 14 bound rows (x ≤ u, -x ≤ -l) then the damper rows, unused ones
 /// written as 0·x ≤ 1.
 struct Clarabel {
@@ -620,6 +617,10 @@ fn settings() -> DefaultSettings<Real> {
         .presolve_enable(false)
         .equilibrate_enable(false)
         .input_sparse_dropzeros(false)
+        .iterative_refinement_enable(false)
+        .tol_gap_abs(1e-7)
+        .tol_gap_rel(1e-7)
+        .tol_feas(1e-7)
         .max_iter(100)
         .build()
         .unwrap_or_default()
@@ -664,4 +665,80 @@ fn median(values: &[Real]) -> Real {
     let mut sorted = values.to_vec();
     sorted.sort_by(Real::total_cmp);
     sorted[sorted.len() / 2]
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::rngs::StdRng;
+    use rand::{RngExt, SeedableRng};
+
+    use super::*;
+
+    fn random_problem(rng: &mut StdRng) -> (Matrix7, Vector7) {
+        let j = Matrix7::from_fn(|_, _| rng.random_range(-1.0..1.0));
+        let w = Vector7::from_fn(|_, _| rng.random_range(0.1..10.0));
+        let weighted = Matrix7::from_diagonal(&w.component_mul(&w)) * j;
+        let p = j.transpose() * weighted + Matrix7::identity() * 1e-6;
+        let v = Vector7::from_fn(|_, _| rng.random_range(-1.0..1.0));
+        (p, weighted.transpose() * v)
+    }
+
+    fn objective(p: &Matrix7, c: &Vector7, x: &Vector7) -> Real {
+        0.5 * x.dot(&(p * x)) - c.dot(x)
+    }
+
+    #[test]
+    fn clarabel_agrees_with_least_squares_when_nothing_binds() {
+        let mut rng = StdRng::seed_from_u64(1);
+        let mut solver = Clarabel::new(2).expect("set up");
+        for _ in 0..50 {
+            let (p, c) = random_problem(&mut rng);
+            let exact = p.cholesky().expect("positive definite").solve(&c);
+            let bound = Vector7::repeat(10.0 * exact.amax() + 1.0);
+            let x = solver.solve(&p, &c, &-bound, &bound, &[]).expect("solves");
+            assert!((x - exact).amax() < 1e-6 * (1.0 + exact.amax()), "{x} vs {exact}");
+        }
+    }
+
+    #[test]
+    fn clarabel_is_feasible_and_no_feasible_point_does_better() {
+        let mut rng = StdRng::seed_from_u64(2);
+        let mut solver = Clarabel::new(2).expect("set up");
+        for _ in 0..30 {
+            let (p, c) = random_problem(&mut rng);
+            let exact = p.cholesky().expect("positive definite").solve(&c);
+            // Bounds at half the unconstrained step, and two rows cutting it off.
+            let (upper, lower) = (exact.abs() * 0.5 + Vector7::repeat(0.01), -exact.abs() * 0.5);
+            let rows: Vec<(Vector7, Real)> = (0..2)
+                .map(|_| (Vector7::from_fn(|_, _| rng.random_range(-1.0..1.0)), 0.01))
+                .collect();
+            let x = solver.solve(&p, &c, &lower, &upper, &rows).expect("solves");
+            let feasible = |y: &Vector7, tol: Real| {
+                (0..DOF).all(|i| y[i] >= lower[i] - tol && y[i] <= upper[i] + tol)
+                    && rows.iter().all(|(a, b)| a.dot(y) <= b + tol)
+            };
+            assert!(feasible(&x, 1e-6));
+            let best = objective(&p, &c, &x);
+            for _ in 0..2000 {
+                let y = x + Vector7::from_fn(|_, _| rng.random_range(-1e-2..1e-2));
+                if feasible(&y, 0.0) {
+                    assert!(objective(&p, &c, &y) >= best - 1e-7, "a feasible point does better");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn options_out_of_range_are_refused() {
+        let bad = [
+            QpOptions { gain: 600.0, ..QpOptions::default() },
+            QpOptions { influence: 0.005, ..QpOptions::default() },
+            QpOptions { velocity_fraction: 1.5, ..QpOptions::default() },
+            QpOptions { rest_speed: 0.0, ..QpOptions::default() },
+        ];
+        for o in bad {
+            assert!(matches!(check_options(&o), Err(QpError::InvalidOptions { .. })), "{o:?}");
+        }
+        assert!(check_options(&QpOptions::default()).is_ok());
+    }
 }
