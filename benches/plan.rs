@@ -1,0 +1,108 @@
+//! Planning: one velocity-QP segment (per step = time / steps) in free space and grazing an
+//! obstacle, and whole tasks (decomposition + QP + joining) on COMAN and Centauro.
+
+use std::hint::black_box;
+
+use a2ml::Robot;
+use a2ml::collision::CollisionScene;
+use a2ml::kinematics::{arm_pose, cpsa_state};
+use a2ml::language::{self, Obstacle, PathFeature, Shape, Space, Target, Variable};
+use a2ml::math::{JointVector, Real, Rotation3, Vector3};
+use a2ml::profile::{BodyFrames, Reference, Role};
+use a2ml::solve::qp::{Component, QpOptions, SegmentProblem, solve_segment};
+use a2ml::solve::{PlanOptions, plan};
+use criterion::{Criterion, criterion_group, criterion_main};
+
+fn path(relative: &str) -> String {
+    format!("{}/{relative}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// COMAN's hand in front of the body; Pw 12 cm along a line, Ow and θsw held, 1.2 s.
+fn line_segment(robot: &Robot, q0: &JointVector) -> SegmentProblem {
+    let s = cpsa_state(robot, &arm_pose(robot, q0)).expect("regular start");
+    let duration = 1.2;
+    let line = PathFeature::Line { direction: Vector3::new(0.0, -1.0, 0.2), length: Some(0.12) };
+    let frames = BodyFrames { shoulder_frame: Rotation3::identity(), ow: s.ow };
+    let held = |variable, value| Reference::hold(variable, value, duration).expect("hold");
+    let pw = Reference::path(Variable::Pw, Target::Position(s.pw), &line, &frames, duration)
+        .expect("line");
+    let component = |variable, reference| Component { variable, reference, role: Role::Path };
+    SegmentProblem {
+        space: Space::Cpsa,
+        components: [
+            component(Variable::Pw, pw),
+            component(Variable::Ow, held(Variable::Ow, Target::Rotation(s.ow))),
+            component(Variable::Swivel, held(Variable::Swivel, Target::Angle(s.swivel))),
+        ],
+        duration,
+    }
+}
+
+fn qp(c: &mut Criterion) {
+    let robot = Robot::from_urdf_file(path("robots/coman_right_arm.urdf")).expect("robot");
+    let q0 = JointVector::from_fn(|i, _| [-10.0 as Real, -15.0, 45.0, -100.0, 0.0, 0.0, 0.0][i])
+        .map(Real::to_radians);
+    let problem = line_segment(&robot, &q0);
+    let p0 = arm_pose(&robot, &q0).wrist;
+    let slab = Obstacle {
+        name: "slab".into(),
+        shape: Shape::Box {
+            center: p0 + Vector3::new(0.0, -0.08, -0.09),
+            size: Vector3::new(0.3, 0.1, 0.05),
+        },
+    };
+    let options = QpOptions::default();
+    let mut group = c.benchmark_group("qp");
+    for (name, scene) in [
+        ("segment_free", CollisionScene::new(&[])),
+        ("segment_grazing_box", CollisionScene::new(&[slab])),
+    ] {
+        let steps = solve_segment(&robot, &scene, &problem, &q0, &options).expect("solves");
+        eprintln!(
+            "qp/{name}: {} steps, {} with Clarabel; step medians {:.2} µs (least squares), \
+             {:.1} µs (Clarabel)",
+            steps.stats.steps,
+            steps.stats.clarabel_steps,
+            steps.stats.median_fast_time * 1e6,
+            steps.stats.median_clarabel_time * 1e6
+        );
+        group.bench_function(name, |b| {
+            b.iter(|| solve_segment(&robot, &scene, black_box(&problem), &q0, &options))
+        });
+    }
+    group.finish();
+}
+
+fn tasks(c: &mut Criterion) {
+    let mut group = c.benchmark_group("plan");
+    group.sample_size(20);
+    for name in ["push_box_aside_coman", "push_box_aside_centauro", "construct_path_line"] {
+        let task = language::load(path(&format!("examples/{name}.a2ml"))).expect("task loads");
+        let robot = Robot::from_urdf_file(&task.robot).expect("robot");
+        let options = PlanOptions::default();
+        match plan(&robot, &task, &options) {
+            Ok(p) => {
+                let steps: usize = p.segments.iter().map(|s| s.qp.steps).sum();
+                let clarabel: usize = p.segments.iter().map(|s| s.qp.clarabel_steps).sum();
+                eprintln!(
+                    "plan/{name}: {} segments, {steps} QP steps, {:.1} % with Clarabel",
+                    p.segments.len(),
+                    100.0 * clarabel as Real / steps.max(1) as Real
+                );
+            }
+            Err(e) => {
+                eprintln!("plan/{name}: skipped, {e}");
+                continue;
+            }
+        }
+        group.bench_function(name, |b| b.iter(|| plan(&robot, black_box(&task), &options)));
+        let decompose_options = a2ml::decompose::DecomposeOptions::default();
+        group.bench_function(format!("{name}/decompose_only"), |b| {
+            b.iter(|| a2ml::decompose::decompose(&robot, black_box(&task), &decompose_options))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, qp, tasks);
+criterion_main!(benches);
