@@ -30,7 +30,7 @@ type Dict<'py> = Bound<'py, PyDict>;
 #[pyclass(frozen, module = "a2ml", name = "Task")]
 pub(crate) struct PyTask {
     pub(crate) task: language::Task,
-    source: String,
+    pub(crate) source: String,
     path: Option<PathBuf>,
 }
 
@@ -167,7 +167,7 @@ pub(crate) fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyTask> {
 
 /// The Python spelling of a variable: the argument names of `Robot.ik_cpsa`
 /// and `Robot.ik_hat`.
-fn variable_name(v: Variable) -> &'static str {
+pub(crate) fn variable_name(v: Variable) -> &'static str {
     match v {
         Variable::Pw => "pw",
         Variable::Ow => "ow",
@@ -181,11 +181,21 @@ pub(crate) fn variable_names(vs: &[Variable]) -> Vec<&'static str> {
     vs.iter().copied().map(variable_name).collect()
 }
 
+/// The variable spelled `name` as [`variable_name`] spells it.
+pub(crate) fn variable_from_name(name: &str) -> Option<Variable> {
+    Variable::ALL.into_iter().find(|v| variable_name(*v) == name)
+}
+
 pub(crate) fn space_name(s: Space) -> &'static str {
     match s {
         Space::Cpsa => "cpsa",
         Space::Hat => "hat",
     }
+}
+
+/// The space spelled `name` as [`space_name`] spells it.
+pub(crate) fn space_from_name(name: &str) -> Option<Space> {
+    [Space::Cpsa, Space::Hat].into_iter().find(|s| space_name(*s) == name)
 }
 
 /// (3,) array (m), (3, 3) array or float (rad).

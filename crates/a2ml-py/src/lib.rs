@@ -3,16 +3,19 @@
 //! the core and converts the result; all kinematics lives in the core.
 //! Arrays cross as float64 numpy arrays; frames and units as in DESIGN.md §2.
 //! The task language is in [`language`], the decomposition in
-//! [`decompose`]; exceptions and their mapping here.
+//! [`decompose`], planning and its outputs in [`plan`]; exceptions and their
+//! mapping here.
 
 mod decompose;
 mod language;
+mod plan;
 
 use std::path::{Path, PathBuf};
 
 use a2ml_core::kinematics::{self, CpsaState, HatState, KinematicsError};
 use a2ml_core::language::{Diagnostics, LanguageError};
 use a2ml_core::math::{DOF, JointVector, Matrix3, Real, Rotation3, Vector3};
+use a2ml_core::output::OutputError;
 use a2ml_core::robot::{RobotError, RobotOptions};
 use a2ml_core::solve::SolveError;
 use numpy::ndarray::Array2;
@@ -57,6 +60,12 @@ create_exception!(
     A2mlError,
     "The task cannot be decomposed into actions and movement segments."
 );
+create_exception!(
+    a2ml,
+    PlanError,
+    A2mlError,
+    "A decomposed task cannot be solved: a solver is unavailable, or a segment's references or QP fail."
+);
 
 /// A core error on its way to Python (polars' newtype pattern): the one
 /// place that decides which exception class each error kind becomes.
@@ -76,6 +85,18 @@ impl From<KinematicsError> for CoreError {
 
 impl From<LanguageError> for CoreError {
     fn from(e: LanguageError) -> Self {
+        Self(e.into())
+    }
+}
+
+impl From<SolveError> for CoreError {
+    fn from(e: SolveError) -> Self {
+        Self(e.into())
+    }
+}
+
+impl From<OutputError> for CoreError {
+    fn from(e: OutputError) -> Self {
         Self(e.into())
     }
 }
@@ -114,7 +135,9 @@ impl From<CoreError> for PyErr {
             // No profile or trajectory API in Python yet; the base class until there is.
             Error::Profile(_) | Error::Trajectory(_) => A2mlError::new_err(message),
             Error::Solve(SolveError::Decompose(_)) => DecomposeError::new_err(message),
-            Error::Solve(_) => A2mlError::new_err(message),
+            // A rate passed to `plan` (the task's own is validated when parsed).
+            Error::Solve(SolveError::InvalidRate { .. }) => PyValueError::new_err(message),
+            Error::Solve(_) => PlanError::new_err(message),
         }
     }
 }
@@ -282,6 +305,11 @@ pub(crate) struct PyRobot {
 }
 
 impl PyRobot {
+    /// A robot loaded by the core with the default chain options.
+    pub(crate) fn new(robot: a2ml_core::Robot) -> Self {
+        Self { robot, base: None, tip: None }
+    }
+
     fn options(base: &Option<String>, tip: &Option<String>) -> RobotOptions {
         RobotOptions { base: base.clone(), tip: tip.clone(), ..RobotOptions::default() }
     }
@@ -544,6 +572,9 @@ fn _a2ml(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(language::parse, m)?)?;
     m.add_function(wrap_pyfunction!(language::load, m)?)?;
     m.add_function(wrap_pyfunction!(decompose::decompose, m)?)?;
+    m.add_class::<plan::PyPlan>()?;
+    m.add_class::<plan::PySegmentReport>()?;
+    m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     m.add("A2mlError", py.get_type::<A2mlError>())?;
     m.add("UrdfError", py.get_type::<UrdfError>())?;
     m.add("ParseError", py.get_type::<ParseError>())?;
@@ -552,5 +583,6 @@ fn _a2ml(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SingularityError", py.get_type::<SingularityError>())?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     m.add("DecomposeError", py.get_type::<DecomposeError>())?;
+    m.add("PlanError", py.get_type::<PlanError>())?;
     Ok(())
 }

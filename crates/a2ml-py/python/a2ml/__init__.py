@@ -10,13 +10,19 @@ shoulder centre. Arrays are float64 numpy arrays.
 >>> pw, ow, swivel = robot.cpsa([0.1, 0.5, 0.0, -1.2, 0.0, 0.4, 0.0])  # doctest: +SKIP
 >>> task = a2ml.load("push.a2ml")  # doctest: +SKIP
 >>> task.actions[0]["goal"]["primary"]["pw"]  # doctest: +SKIP
->>> plan = a2ml.decompose(task)  # doctest: +SKIP
->>> plan["actions"][0]["type"], plan["actions"][0]["segments"][0]["end"]  # doctest: +SKIP
+>>> d = a2ml.decompose(task)  # doctest: +SKIP
+>>> d["actions"][0]["type"], d["actions"][0]["segments"][0]["end"]  # doctest: +SKIP
+>>> plan = a2ml.plan("push.a2ml")  # doctest: +SKIP
+>>> plan.t.shape, plan.q.shape, plan.reached  # doctest: +SKIP
+>>> plan.write_mcap("push.mcap")  # doctest: +SKIP
 
 Invalid task text raises :class:`ParseError`, located by ``line`` and
 ``column`` and rendered in full by ``str()``; a task that cannot be
-decomposed raises :class:`DecomposeError`. :class:`Decomposition` and the
-other ``TypedDict`` classes describe what :func:`decompose` returns.
+decomposed raises :class:`DecomposeError`, one that cannot be solved
+:class:`PlanError`. :class:`Decomposition` and the other ``TypedDict``
+classes describe what :func:`decompose` returns; :class:`VariableError`,
+:class:`Clearance` and :class:`QpStats` are the records of a
+:class:`SegmentReport`.
 """
 
 from a2ml._a2ml import (
@@ -25,7 +31,10 @@ from a2ml._a2ml import (
     DecomposeError,
     JointLimitError,
     ParseError,
+    Plan,
+    PlanError,
     Robot,
+    SegmentReport,
     SingularityError,
     Task,
     UnreachableError,
@@ -34,26 +43,42 @@ from a2ml._a2ml import (
     decompose,
     load,
     parse,
+    plan,
 )
-from a2ml._types import Decomposition, OptReport, PlannedAction, PlannedSegment
+from a2ml._types import (
+    Clearance,
+    Decomposition,
+    OptReport,
+    PlannedAction,
+    PlannedSegment,
+    QpStats,
+    VariableError,
+)
 
 __all__ = [
     "A2mlError",
+    "Clearance",
     "ConvergenceError",
     "DecomposeError",
     "Decomposition",
     "JointLimitError",
     "OptReport",
     "ParseError",
+    "Plan",
+    "PlanError",
     "PlannedAction",
     "PlannedSegment",
+    "QpStats",
     "Robot",
+    "SegmentReport",
     "SingularityError",
     "Task",
     "UnreachableError",
     "UrdfError",
+    "VariableError",
     "__version__",
     "decompose",
     "load",
     "parse",
+    "plan",
 ]

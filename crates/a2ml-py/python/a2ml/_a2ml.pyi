@@ -13,16 +13,18 @@ units: state variables are spelled as :class:`Robot` names them (``"pw"``,
 ``"ow"``, ``"swivel"``, ``"os"``, ``"elbow"``), positions are arrays of shape
 (3,), rotations (3, 3), angles floats. :func:`decompose` turns a task into
 movement segments, returned in the same spelling (keys as in
-:class:`a2ml.Decomposition`).
+:class:`a2ml.Decomposition`). :func:`plan` solves them into a :class:`Plan`:
+the joint trajectory at the output rate, one :class:`SegmentReport` per
+segment, and the MCAP, CSV and JSON writers (DESIGN.md §6).
 """
 
 import os
-from typing import Any, ClassVar, final
+from typing import Any, ClassVar, Literal, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from a2ml._types import Decomposition
+from a2ml._types import Clearance, Decomposition, QpStats, VariableError
 
 __all__ = [
     "__version__",
@@ -31,6 +33,9 @@ __all__ = [
     "parse",
     "load",
     "decompose",
+    "plan",
+    "Plan",
+    "SegmentReport",
     "A2mlError",
     "UrdfError",
     "ParseError",
@@ -39,6 +44,7 @@ __all__ = [
     "SingularityError",
     "ConvergenceError",
     "DecomposeError",
+    "PlanError",
 ]
 
 __version__: str
@@ -88,6 +94,14 @@ class DecomposeError(A2mlError):
     action's constraints fit none of the seven types, a path leaves out a
     size nothing chooses, or a segment's goal is out of reach within the
     joint limits. ``str(e)`` names the task or action (and segment)."""
+
+class PlanError(A2mlError):
+    """A decomposed task cannot be solved: the solver asked for is not
+    available yet, a segment's references cannot be built, the QP fails on a
+    segment (e.g. a singular configuration), or the segments cannot be
+    joined. ``str(e)`` names the action and segment. A goal missed beyond
+    tolerance is not an error: see :attr:`Plan.reached` and
+    :attr:`Plan.warnings`."""
 
 @final
 class Robot:
@@ -388,4 +402,225 @@ def decompose(task: Task, robot: Robot | None = None) -> Decomposition:
         DecomposeError: the task cannot be decomposed (the message says why).
         UrdfError: ``robot`` is None and the task's robot file cannot be
             loaded as a 7-DoF arm.
+    """
+
+@final
+class SegmentReport:
+    """What one movement segment did, as solved; immutable.
+
+    Spelled as :func:`decompose` spells segments: spaces ``"cpsa"`` or
+    ``"hat"``, variables ``"pw"``, ``"ow"``, ``"swivel"``, ``"os"``,
+    ``"elbow"``. Reports compare equal when every field is equal and pickle.
+    """
+
+    __hash__: ClassVar[None]  # type: ignore[assignment]
+
+    def __reduce__(self) -> tuple[Any, tuple[dict[str, Any]]]:
+        """Pickle as its :meth:`to_dict`."""
+
+    def __eq__(self, value: object, /) -> bool:
+        """Equal when every field is equal."""
+
+    @property
+    def action(self) -> str:
+        """The action's name."""
+
+    @property
+    def action_index(self) -> int:
+        """The action's index in :attr:`Task.actions`."""
+
+    @property
+    def segment(self) -> int:
+        """The segment's index within its action, 0-based."""
+
+    @property
+    def action_type(self) -> Literal["I", "II", "III", "IV", "V", "VI", "VII"] | None:
+        """The action's type, or None for an action written as explicit segments."""
+
+    @property
+    def space(self) -> Literal["cpsa", "hat"]:
+        """The segment's representation space."""
+
+    @property
+    def pattern(self) -> int:
+        """1 (every primitive a path or hold), 2 (every primitive a goal) or 3 (both)."""
+
+    @property
+    def solver(self) -> str:
+        """The solver that produced the motion (``"qp"``; never ``"auto"``)."""
+
+    @property
+    def focus(self) -> list[str]:
+        """The focus of interest: the variables of the segment's featured primitive."""
+
+    @property
+    def start(self) -> float:
+        """Start in the plan's time (s)."""
+
+    @property
+    def end(self) -> float:
+        """End in the plan's time (s), settling included."""
+
+    @property
+    def duration(self) -> float:
+        """The segment's own duration before joining (s)."""
+
+    @property
+    def settle(self) -> float:
+        """Time the solver ran past the reference's end to settle on the goal (s)."""
+
+    @property
+    def errors(self) -> dict[str, VariableError]:
+        """The final error of every variable of the segment's space, in the
+        space's order (``pw``, ``ow``, ``swivel`` or ``os``, ``elbow``, ``ow``)."""
+
+    @property
+    def path_errors(self) -> dict[str, VariableError]:
+        """The largest deviation of each path or held variable from its reference."""
+
+    @property
+    def clearance(self) -> Clearance | None:
+        """The smallest clearance over the segment's samples, or None when
+        there is no pair to measure."""
+
+    @property
+    def limit_margin(self) -> float:
+        """The smallest distance of any joint to its position limits over the segment (rad)."""
+
+    @property
+    def stalled(self) -> bool:
+        """Whether the solver stopped making progress short of the goal."""
+
+    @property
+    def reached(self) -> bool:
+        """Whether every variable is within tolerance at the end."""
+
+    @property
+    def qp(self) -> QpStats:
+        """The velocity QP's counters and timings over the segment."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """Every field above in one dict (records as their NamedTuples), e.g.
+        for ``pandas.DataFrame([s.to_dict() for s in plan.segments])``."""
+
+@final
+class Plan:
+    """A planned task: the joint trajectory at the output rate and what each
+    segment did; immutable. Create one with :func:`plan`.
+
+    Every array property builds a fresh float64 array. A plan keeps the
+    :class:`Robot` and :class:`Task` it was planned from (the task's source is
+    attached to the MCAP file) and pickles as its data, without planning again.
+    """
+
+    def __reduce__(self) -> tuple[Any, tuple[Robot, Task, dict[str, Any]]]:
+        """Pickle as the robot, the task and the plan's data."""
+
+    @property
+    def t(self) -> NDArray[np.float64]:
+        """Sample times (s), shape (N,): every 1 / :attr:`rate` from 0, and the
+        plan's end as the last sample (so the last step may be shorter)."""
+
+    @property
+    def q(self) -> NDArray[np.float64]:
+        """Joint positions (rad), shape (N, 7), columns in :attr:`joint_names` order."""
+
+    @property
+    def qd(self) -> NDArray[np.float64]:
+        """Joint velocities (rad/s), shape (N, 7)."""
+
+    @property
+    def joint_names(self) -> list[str]:
+        """Joint names, base to tip: the columns of :attr:`q` and :attr:`qd`."""
+
+    @property
+    def rate(self) -> float:
+        """Output rate (Hz)."""
+
+    @property
+    def segments(self) -> list[SegmentReport]:
+        """One report per movement segment, in time order."""
+
+    @property
+    def warnings(self) -> list[str]:
+        """Goals missed beyond tolerance, each naming the action and segment."""
+
+    @property
+    def reached(self) -> bool:
+        """Whether every segment reached its goals within tolerance."""
+
+    @property
+    def wrist_reference(self) -> NDArray[np.float64]:
+        """The wrist path Pw the segments were asked to follow, shape (M, 4):
+        rows ``(t, x, y, z)`` in s and m, in {b}, at :attr:`rate`."""
+
+    @property
+    def safety_distance(self) -> float:
+        """The distance the solvers kept from obstacles (m)."""
+
+    @property
+    def task(self) -> Task:
+        """The task that was planned."""
+
+    @property
+    def robot(self) -> Robot:
+        """The robot it was planned on."""
+
+    def write_mcap(self, path: str | os.PathLike[str]) -> None:
+        """Write an MCAP file for Foxglove: ``/joint_states``, ``/tf``,
+        ``/scene``, ``/arm_capsules``, ``/wrist_path``, ``/a2ml/state`` and
+        ``/a2ml/segments``, JSON-encoded with JSON schemas, with the task
+        source and the URDF attached. Written to a temporary file and renamed,
+        so a failure leaves no partial file. Releases the GIL.
+
+        Raises:
+            OSError: the file cannot be written.
+        """
+
+    def to_csv(self, path: str | os.PathLike[str]) -> None:
+        """Write the joint trajectory as CSV: a header ``t``,
+        ``<joint>_pos``..., ``<joint>_vel``... and one row per sample (s, rad,
+        rad/s). Atomic as :meth:`write_mcap`; releases the GIL.
+
+        Raises:
+            OSError: the file cannot be written.
+        """
+
+    def to_json(self, path: str | os.PathLike[str]) -> None:
+        """Write the plan as JSON: joint names, rate, trajectory, segment
+        reports, wrist reference and warnings, with the a2ml version, robot
+        name and URDF path. Atomic as :meth:`write_mcap`; releases the GIL.
+
+        Raises:
+            OSError: the file cannot be written.
+        """
+
+def plan(
+    task_or_path: Task | str | os.PathLike[str],
+    solver: Literal["auto", "qp", "rrt", "map", "gpm", "clik", "pmp"] | None = None,
+    rate: float | None = None,
+    seed: int | None = None,
+    robot: Robot | None = None,
+) -> Plan:
+    """Plan a task (DESIGN.md §4-5): decompose it, solve every segment from
+    where the last one really ended and join them (+Tr within an action, +Se
+    between actions), resampled at ``rate``.
+
+    ``task_or_path`` is a :class:`Task` or the path of a task file (read as
+    :func:`load` does). ``solver`` overrides the solver of the task and of
+    every action (default: theirs; ``"auto"`` and ``"qp"`` run the velocity
+    QP, the others are not available yet). ``rate`` (Hz) overrides the task's
+    ``settings { rate }`` (default 100 Hz); ``seed`` its ``seed``. ``robot``
+    defaults to the task's robot file (:attr:`Task.robot`). A goal missed
+    beyond tolerance is not an error: :attr:`Plan.reached` is False and
+    :attr:`Plan.warnings` say which. Deterministic; releases the GIL.
+
+    Raises:
+        TypeError: ``task_or_path`` is neither a Task nor a path.
+        ValueError: ``solver`` is not a solver's name, or ``rate`` is not
+            positive and finite.
+        FileNotFoundError, OSError, ParseError: as :func:`load`.
+        UrdfError: the task's robot file cannot be loaded as a 7-DoF arm.
+        DecomposeError: the task cannot be decomposed.
+        PlanError: the solver is not available yet, or a segment cannot be solved.
     """

@@ -1,20 +1,29 @@
 """The shapes of the plain data :func:`a2ml.decompose` returns, as
-``TypedDict`` classes (re-exported by :mod:`a2ml`) for annotating user code.
+``TypedDict`` classes, and the small records of :class:`a2ml.SegmentReport`,
+as ``NamedTuple`` classes (all re-exported by :mod:`a2ml`).
 
-At run time the values are ordinary ``dict`` objects; these classes only
-describe their keys. Joint vectors are float64 arrays of shape (7,) (rad),
+At run time the decomposition's values are ordinary ``dict`` objects; the
+``TypedDict`` classes only describe their keys. Joint vectors are float64 arrays of shape (7,) (rad),
 spaces are ``"cpsa"`` or ``"hat"``, variables are spelled as :class:`a2ml.Robot`
 names them (``"pw"``, ``"ow"``, ``"swivel"``, ``"os"``, ``"elbow"``).
 """
 
 # Annotations stay evaluable on Python 3.9 (no ``X | None``), so
 # ``typing.get_type_hints`` works on every supported version.
-from typing import Any, Dict, List, Literal, Optional, TypedDict
+from typing import Any, Dict, List, Literal, NamedTuple, Optional, TypedDict
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Decomposition", "OptReport", "PlannedAction", "PlannedSegment"]
+__all__ = [
+    "Clearance",
+    "Decomposition",
+    "OptReport",
+    "PlannedAction",
+    "PlannedSegment",
+    "QpStats",
+    "VariableError",
+]
 
 # A space is ``"cpsa"`` (Pw, Ow, swivel) or ``"hat"`` (Os, elbow, Ow); spelled
 # out below rather than as an alias, which stubtest cannot compare.
@@ -90,3 +99,38 @@ class Decomposition(TypedDict):
     task: str
     start: NDArray[np.float64]
     actions: List[PlannedAction]
+
+
+class VariableError(NamedTuple):
+    """The error of one state variable at a segment's end, or its largest
+    deviation from its path: distance (m) for ``pw``, geodesic angle (rad)
+    for ``ow`` and ``os``, absolute difference (rad) for ``swivel`` and
+    ``elbow``; ``within`` the tolerance (1 mm, 1 degree)."""
+
+    error: float
+    within: bool
+
+
+class Clearance(NamedTuple):
+    """The smallest clearance over a segment: signed ``distance`` (m; negative
+    is a penetration depth) at ``time`` (s, plan time) between the arm's
+    ``link`` capsule and ``obstacle`` (or another link, for self-collision)."""
+
+    distance: float
+    time: float
+    link: str
+    obstacle: str
+
+
+class QpStats(NamedTuple):
+    """Counters and timings of the velocity QP over a segment: control
+    ``steps``, the ``clarabel_steps`` where a bound or collision row was
+    binding, the mean and longest step (s), and the median time of the steps
+    solved by weighted least squares and by Clarabel (s; 0 when none)."""
+
+    steps: int
+    clarabel_steps: int
+    mean_step_time: float
+    worst_step_time: float
+    median_fast_time: float
+    median_clarabel_time: float

@@ -1,0 +1,570 @@
+//! `a2ml.plan`, `a2ml.Plan` and `a2ml.SegmentReport`: a task planned into one joint
+//! trajectory at the output rate, what each segment did, and the writers of DESIGN.md §6.
+//!
+//! Arrays are float64: `t` (N,) s, `q` and `qd` (N, 7) rad and rad/s, the wrist reference
+//! (M, 4) as t, x, y, z (s, m in {b}). Reports are spelled as [`crate::decompose`] spells
+//! segments; their small records are the NamedTuples of `a2ml._types`. A plan keeps its
+//! `Robot` and `Task` (whose source MCAP attaches) and pickles as its data, rebuilt here,
+//! because the core types serialize but do not deserialize.
+
+use std::borrow::Cow;
+use std::path::PathBuf;
+
+use a2ml_core::decompose::{ActionType, SegmentPattern};
+use a2ml_core::language::SolverChoice;
+use a2ml_core::math::{DOF, JointVector, Real, Vector3};
+use a2ml_core::output;
+use a2ml_core::solve::{self, Plan, PlanOptions, QpStats, SegmentReport, VariableError};
+use a2ml_core::trajectory::{Clearance, Trajectory};
+use numpy::IntoPyArray;
+use numpy::ndarray::Array2;
+use pyo3::call::PyCallArgs;
+use pyo3::exceptions::{PyKeyError, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString, PyTuple, PyType};
+
+use crate::language::{self, PyTask, space_from_name, space_name, variable_from_name};
+use crate::{CoreError, Matrix, PyRobot, Vector, read_array, to_vector};
+
+type Dict<'py> = Bound<'py, PyDict>;
+
+/// Plans a task, or the task file at a path, on its robot (or `robot`), releasing the GIL.
+#[pyfunction]
+#[pyo3(signature = (task_or_path, solver=None, rate=None, seed=None, robot=None))]
+pub(crate) fn plan(
+    py: Python<'_>,
+    task_or_path: &Bound<'_, PyAny>,
+    solver: Option<&str>,
+    rate: Option<Real>,
+    seed: Option<u64>,
+    robot: Option<Bound<'_, PyRobot>>,
+) -> PyResult<PyPlan> {
+    let task = match task_or_path.cast::<PyTask>() {
+        Ok(task) => task.clone(),
+        Err(_) => Bound::new(py, language::load(py, task_path(task_or_path)?)?)?,
+    };
+    let options = PlanOptions {
+        solver: solver.map(solver_choice).transpose()?,
+        rate,
+        ..PlanOptions::default()
+    };
+    let planned_task = match seed {
+        Some(seed) => {
+            let mut seeded = task.get().task.clone();
+            seeded.settings.seed = seed;
+            Cow::Owned(seeded)
+        }
+        None => Cow::Borrowed(&task.get().task),
+    };
+    let robot = match robot {
+        Some(robot) => robot.unbind(),
+        None => {
+            let urdf = &planned_task.robot;
+            let loaded = py.detach(|| a2ml_core::Robot::from_urdf_file(urdf));
+            Py::new(py, PyRobot::new(loaded.map_err(CoreError::from)?))?
+        }
+    };
+    let planned = py
+        .detach(|| solve::plan(&robot.get().robot, &planned_task, &options))
+        .map_err(CoreError::from)?;
+    Ok(PyPlan { plan: planned, robot, task: task.unbind() })
+}
+
+/// `task_or_path` as a path, or the TypeError naming what it was.
+fn task_path(value: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
+    value.extract::<PathBuf>().map_err(|_| {
+        let kind = value.get_type().name().map_or_else(|_| "?".to_owned(), |n| n.to_string());
+        PyTypeError::new_err(format!("task_or_path must be an a2ml.Task or a path, not {kind}"))
+    })
+}
+
+fn solver_choice(name: &str) -> PyResult<SolverChoice> {
+    SolverChoice::NAMES.iter().find(|(n, _)| *n == name).map(|(_, s)| *s).ok_or_else(|| {
+        let names: Vec<&str> = SolverChoice::NAMES.iter().map(|(n, _)| *n).collect();
+        PyValueError::new_err(format!("unknown solver '{name}' ({})", names.join(", ")))
+    })
+}
+
+/// A planned task: the joint trajectory at the output rate and one report per segment;
+/// immutable. Keeps the `Robot` and `Task` it was planned from; pickles as its data.
+#[pyclass(frozen, module = "a2ml", name = "Plan")]
+pub(crate) struct PyPlan {
+    plan: Plan,
+    robot: Py<PyRobot>,
+    task: Py<PyTask>,
+}
+
+#[pymethods]
+impl PyPlan {
+    /// Sample times (s), shape (N,): every 1 / rate from 0, and the end.
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Vector<'py> {
+        to_vector(py, self.plan.trajectory.times())
+    }
+
+    /// Joint positions (rad), shape (N, 7).
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> Matrix<'py> {
+        joint_rows(py, self.plan.trajectory.positions())
+    }
+
+    /// Joint velocities (rad/s), shape (N, 7).
+    #[getter]
+    fn qd<'py>(&self, py: Python<'py>) -> Matrix<'py> {
+        joint_rows(py, self.plan.trajectory.velocities())
+    }
+
+    /// Joint names, in the order of the columns of q.
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        self.plan.joint_names.clone()
+    }
+
+    /// Output rate (Hz).
+    #[getter]
+    fn rate(&self) -> Real {
+        self.plan.rate
+    }
+
+    /// One report per segment, in time order.
+    #[getter]
+    fn segments(&self) -> Vec<PySegmentReport> {
+        self.plan.segments.iter().map(|r| PySegmentReport { report: r.clone() }).collect()
+    }
+
+    /// Goals missed beyond tolerance, each naming its action and segment.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.plan.warnings.clone()
+    }
+
+    /// Whether every segment reached its goals within tolerance.
+    #[getter]
+    fn reached(&self) -> bool {
+        self.plan.reached()
+    }
+
+    /// The reference wrist path: rows (t, x, y, z) in s and m in {b}, shape (M, 4).
+    #[getter]
+    fn wrist_reference<'py>(&self, py: Python<'py>) -> Matrix<'py> {
+        let rows = &self.plan.wrist_reference;
+        Array2::from_shape_fn((rows.len(), 4), |(i, j)| match j {
+            0 => rows[i].0,
+            _ => rows[i].1[j - 1],
+        })
+        .into_pyarray(py)
+    }
+
+    /// The distance the solvers kept from obstacles (m).
+    #[getter]
+    fn safety_distance(&self) -> Real {
+        self.plan.safety_distance
+    }
+
+    /// The task that was planned.
+    #[getter]
+    fn task(&self, py: Python<'_>) -> Py<PyTask> {
+        self.task.clone_ref(py)
+    }
+
+    /// The robot it was planned on.
+    #[getter]
+    fn robot(&self, py: Python<'_>) -> Py<PyRobot> {
+        self.robot.clone_ref(py)
+    }
+
+    /// Writes the MCAP recording for Foxglove, releasing the GIL.
+    fn write_mcap(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let (robot, task) = (&self.robot.get().robot, self.task.get());
+        py.detach(|| output::write_mcap(&path, robot, &task.task, &task.source, &self.plan))
+            .map_err(CoreError::from)?;
+        Ok(())
+    }
+
+    /// Writes the joint trajectory as CSV, releasing the GIL.
+    fn to_csv(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let robot = &self.robot.get().robot;
+        py.detach(|| output::write_csv(&path, robot, &self.plan)).map_err(CoreError::from)?;
+        Ok(())
+    }
+
+    /// Writes the plan as JSON, releasing the GIL.
+    fn to_json(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let (robot, task) = (&self.robot.get().robot, &self.task.get().task);
+        py.detach(|| output::write_json(&path, robot, task, &self.plan))
+            .map_err(CoreError::from)?;
+        Ok(())
+    }
+
+    /// Pickles as `Plan._from_state(robot, task, state)`.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let this = slf.get();
+        let state = PyDict::new(py);
+        state.set_item("task", &this.plan.task)?;
+        state.set_item("joint_names", this.joint_names())?;
+        state.set_item("rate", this.plan.rate)?;
+        state.set_item("t", this.t(py))?;
+        state.set_item("q", this.q(py))?;
+        state.set_item("qd", this.qd(py))?;
+        state.set_item("segments", this.segments())?;
+        state.set_item("wrist_reference", this.wrist_reference(py))?;
+        state.set_item("safety_distance", this.plan.safety_distance)?;
+        state.set_item("warnings", this.warnings())?;
+        let rebuild = slf.get_type().getattr("_from_state")?;
+        let args = (this.robot.clone_ref(py), this.task.clone_ref(py), state).into_pyobject(py)?;
+        PyTuple::new(py, [rebuild, args.into_any()])
+    }
+
+    /// The inverse of `__reduce__`.
+    #[classmethod]
+    fn _from_state(
+        _cls: &Bound<'_, PyType>,
+        robot: Py<PyRobot>,
+        task: Py<PyTask>,
+        state: &Bound<'_, PyDict>,
+    ) -> PyResult<Self> {
+        let t = item(state, "t")?;
+        let samples = t.len()?;
+        let times = read_array(&t, "t", &[samples])?;
+        let positions = read_joint_rows(&item(state, "q")?, "q", samples)?;
+        let velocities = read_joint_rows(&item(state, "qd")?, "qd", samples)?;
+        let trajectory = Trajectory::new(times, positions, velocities)
+            .map_err(|e| PyValueError::new_err(format!("invalid plan trajectory: {e}")))?;
+        let reference = item(state, "wrist_reference")?;
+        let rows = reference.len()?;
+        let wrist_reference = read_array(&reference, "wrist_reference", &[rows, 4])?
+            .chunks_exact(4)
+            .map(|r| (r[0], Vector3::new(r[1], r[2], r[3])))
+            .collect();
+        let segments: Vec<Bound<'_, PySegmentReport>> = item(state, "segments")?.extract()?;
+        let plan = Plan {
+            task: item(state, "task")?.extract()?,
+            joint_names: item(state, "joint_names")?.extract()?,
+            rate: item(state, "rate")?.extract()?,
+            trajectory,
+            segments: segments.iter().map(|s| s.get().report.clone()).collect(),
+            wrist_reference,
+            safety_distance: item(state, "safety_distance")?.extract()?,
+            warnings: item(state, "warnings")?.extract()?,
+        };
+        Ok(Self { plan, robot, task })
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(format!(
+            "Plan(task={}, samples={}, duration={}, segments={}, reached={})",
+            PyString::new(py, &self.plan.task).repr()?,
+            self.plan.trajectory.len(),
+            self.plan.trajectory.duration(),
+            self.plan.segments.len(),
+            if self.plan.reached() { "True" } else { "False" }
+        ))
+    }
+}
+
+/// Joint vectors as the rows of an (N, 7) array.
+fn joint_rows<'py>(py: Python<'py>, rows: &[JointVector]) -> Matrix<'py> {
+    Array2::from_shape_fn((rows.len(), DOF), |(i, j)| rows[i][j]).into_pyarray(py)
+}
+
+fn read_joint_rows(
+    value: &Bound<'_, PyAny>,
+    name: &str,
+    samples: usize,
+) -> PyResult<Vec<JointVector>> {
+    let values = read_array(value, name, &[samples, DOF])?;
+    Ok(values.chunks_exact(DOF).map(JointVector::from_row_slice).collect())
+}
+
+/// `state[key]`, or a KeyError naming the key.
+fn item<'py>(state: &Bound<'py, PyDict>, key: &str) -> PyResult<Bound<'py, PyAny>> {
+    state.get_item(key)?.ok_or_else(|| PyKeyError::new_err(key.to_owned()))
+}
+
+/// One of the NamedTuples of `a2ml._types`.
+fn record<'py>(
+    py: Python<'py>,
+    name: &str,
+    fields: impl PyCallArgs<'py>,
+) -> PyResult<Bound<'py, PyAny>> {
+    py.import("a2ml._types")?.getattr(name)?.call1(fields)
+}
+
+/// What one movement segment did; immutable, equal when every field is.
+#[pyclass(frozen, module = "a2ml", name = "SegmentReport")]
+pub(crate) struct PySegmentReport {
+    report: SegmentReport,
+}
+
+#[pymethods]
+impl PySegmentReport {
+    /// The action's name.
+    #[getter]
+    fn action(&self) -> &str {
+        &self.report.action
+    }
+
+    /// The action's index in `Task.actions`.
+    #[getter]
+    fn action_index(&self) -> usize {
+        self.report.action_index
+    }
+
+    /// The segment's index within its action (0-based).
+    #[getter]
+    fn segment(&self) -> usize {
+        self.report.segment
+    }
+
+    /// "I" to "VII", or None for an action written as explicit segments.
+    #[getter]
+    fn action_type(&self) -> Option<&'static str> {
+        self.report.action_type.map(ActionType::numeral)
+    }
+
+    /// "cpsa" or "hat".
+    #[getter]
+    fn space(&self) -> &'static str {
+        space_name(self.report.space)
+    }
+
+    /// 1 (paths), 2 (goals) or 3 (both).
+    #[getter]
+    fn pattern(&self) -> u8 {
+        self.report.pattern.number()
+    }
+
+    /// The solver that produced the motion.
+    #[getter]
+    fn solver(&self) -> &'static str {
+        self.report.solver.name()
+    }
+
+    /// The focus of interest: the variables of the featured primitive.
+    #[getter]
+    fn focus(&self) -> Vec<&'static str> {
+        language::variable_names(&self.report.focus)
+    }
+
+    /// Start in the plan's time (s).
+    #[getter]
+    fn start(&self) -> Real {
+        self.report.start
+    }
+
+    /// End in the plan's time (s), settling included.
+    #[getter]
+    fn end(&self) -> Real {
+        self.report.end
+    }
+
+    /// The segment's own duration before joining (s).
+    #[getter]
+    fn duration(&self) -> Real {
+        self.report.duration
+    }
+
+    /// Time run past the reference's end to settle on the goal (s).
+    #[getter]
+    fn settle(&self) -> Real {
+        self.report.settle
+    }
+
+    /// Final error of every variable of the space: `{variable: VariableError}`.
+    #[getter]
+    fn errors<'py>(&self, py: Python<'py>) -> PyResult<Dict<'py>> {
+        variable_errors(py, &self.report.errors)
+    }
+
+    /// Largest deviation of each path variable from its reference.
+    #[getter]
+    fn path_errors<'py>(&self, py: Python<'py>) -> PyResult<Dict<'py>> {
+        variable_errors(py, &self.report.path_errors)
+    }
+
+    /// The smallest clearance over the segment, or None.
+    #[getter]
+    fn clearance<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.report
+            .clearance
+            .as_ref()
+            .map(|c| {
+                let fields = (c.distance, c.time, c.link.as_str(), c.obstacle.as_str());
+                record(py, "Clearance", fields)
+            })
+            .transpose()
+    }
+
+    /// Smallest distance of any joint to its limits over the segment (rad).
+    #[getter]
+    fn limit_margin(&self) -> Real {
+        self.report.limit_margin
+    }
+
+    /// Whether the solver stopped making progress short of the goal.
+    #[getter]
+    fn stalled(&self) -> bool {
+        self.report.stalled
+    }
+
+    /// Whether every variable is within tolerance at the end.
+    #[getter]
+    fn reached(&self) -> bool {
+        self.report.reached
+    }
+
+    /// QP counters and timings.
+    #[getter]
+    fn qp<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let s = &self.report.qp;
+        let fields = (
+            s.steps,
+            s.clarabel_steps,
+            s.mean_step_time,
+            s.worst_step_time,
+            s.median_fast_time,
+            s.median_clarabel_time,
+        );
+        record(py, "QpStats", fields)
+    }
+
+    /// Every field as one dict.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Dict<'py>> {
+        let d = PyDict::new(py);
+        d.set_item("action", self.action())?;
+        d.set_item("action_index", self.action_index())?;
+        d.set_item("segment", self.segment())?;
+        d.set_item("action_type", self.action_type())?;
+        d.set_item("space", self.space())?;
+        d.set_item("pattern", self.pattern())?;
+        d.set_item("solver", self.solver())?;
+        d.set_item("focus", self.focus())?;
+        d.set_item("start", self.start())?;
+        d.set_item("end", self.end())?;
+        d.set_item("duration", self.duration())?;
+        d.set_item("settle", self.settle())?;
+        d.set_item("errors", self.errors(py)?)?;
+        d.set_item("path_errors", self.path_errors(py)?)?;
+        d.set_item("clearance", self.clearance(py)?)?;
+        d.set_item("limit_margin", self.limit_margin())?;
+        d.set_item("stalled", self.stalled())?;
+        d.set_item("reached", self.reached())?;
+        d.set_item("qp", self.qp(py)?)?;
+        Ok(d)
+    }
+
+    /// Pickles as `SegmentReport._from_dict(to_dict())`.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let rebuild = slf.get_type().getattr("_from_dict")?;
+        let args = (slf.get().to_dict(py)?,).into_pyobject(py)?;
+        PyTuple::new(py, [rebuild, args.into_any()])
+    }
+
+    /// The inverse of `to_dict`.
+    #[classmethod]
+    fn _from_dict(_cls: &Bound<'_, PyType>, d: &Bound<'_, PyDict>) -> PyResult<Self> {
+        let action_type: Option<String> = item(d, "action_type")?.extract()?;
+        let space: String = item(d, "space")?.extract()?;
+        let solver: String = item(d, "solver")?.extract()?;
+        let focus: Vec<String> = item(d, "focus")?.extract()?;
+        let clearance: Option<(Real, Real, String, String)> = item(d, "clearance")?.extract()?;
+        let qp: (usize, usize, Real, Real, Real, Real) = item(d, "qp")?.extract()?;
+        let report = SegmentReport {
+            action: item(d, "action")?.extract()?,
+            action_index: item(d, "action_index")?.extract()?,
+            segment: item(d, "segment")?.extract()?,
+            action_type: action_type.as_deref().map(action_type_from_numeral).transpose()?,
+            space: space_from_name(&space).ok_or_else(|| unknown("space", &space))?,
+            pattern: pattern_from_number(item(d, "pattern")?.extract()?)?,
+            solver: solver_choice(&solver)?,
+            focus: focus.iter().map(|v| variable(v)).collect::<PyResult<_>>()?,
+            start: item(d, "start")?.extract()?,
+            end: item(d, "end")?.extract()?,
+            duration: item(d, "duration")?.extract()?,
+            settle: item(d, "settle")?.extract()?,
+            errors: read_variable_errors(&item(d, "errors")?)?,
+            path_errors: read_variable_errors(&item(d, "path_errors")?)?,
+            clearance: clearance.map(|(distance, time, link, obstacle)| Clearance {
+                distance,
+                time,
+                link,
+                obstacle,
+            }),
+            limit_margin: item(d, "limit_margin")?.extract()?,
+            stalled: item(d, "stalled")?.extract()?,
+            reached: item(d, "reached")?.extract()?,
+            qp: QpStats {
+                steps: qp.0,
+                clarabel_steps: qp.1,
+                mean_step_time: qp.2,
+                worst_step_time: qp.3,
+                median_fast_time: qp.4,
+                median_clarabel_time: qp.5,
+            },
+        };
+        Ok(Self { report })
+    }
+
+    fn __eq__(&self, other: &Self) -> bool {
+        self.report == other.report
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(format!(
+            "SegmentReport(action={}, segment={}, space={:?}, solver={:?}, reached={})",
+            PyString::new(py, &self.report.action).repr()?,
+            self.report.segment,
+            self.space(),
+            self.solver(),
+            if self.report.reached { "True" } else { "False" }
+        ))
+    }
+}
+
+/// `{variable: VariableError(error, within)}` in the space's order.
+fn variable_errors<'py>(py: Python<'py>, errors: &[VariableError]) -> PyResult<Dict<'py>> {
+    let d = PyDict::new(py);
+    for e in errors {
+        d.set_item(
+            language::variable_name(e.variable),
+            record(py, "VariableError", (e.error, e.within))?,
+        )?;
+    }
+    Ok(d)
+}
+
+fn read_variable_errors(value: &Bound<'_, PyAny>) -> PyResult<Vec<VariableError>> {
+    let d = value.cast::<PyDict>()?;
+    d.iter()
+        .map(|(name, e)| {
+            let (error, within): (Real, bool) = e.extract()?;
+            Ok(VariableError { variable: variable(&name.extract::<String>()?)?, error, within })
+        })
+        .collect()
+}
+
+fn variable(name: &str) -> PyResult<a2ml_core::language::Variable> {
+    variable_from_name(name).ok_or_else(|| unknown("variable", name))
+}
+
+fn action_type_from_numeral(numeral: &str) -> PyResult<ActionType> {
+    ActionType::ALL
+        .into_iter()
+        .find(|t| t.numeral() == numeral)
+        .ok_or_else(|| unknown("action type", numeral))
+}
+
+fn pattern_from_number(number: u8) -> PyResult<SegmentPattern> {
+    match number {
+        1 => Ok(SegmentPattern::Path),
+        2 => Ok(SegmentPattern::Goal),
+        3 => Ok(SegmentPattern::Mixed),
+        _ => Err(unknown("segment pattern", &number.to_string())),
+    }
+}
+
+fn unknown(what: &str, value: &str) -> PyErr {
+    PyValueError::new_err(format!("unknown {what} '{value}'"))
+}

@@ -1,0 +1,300 @@
+"""The Python API of planning: a2ml.plan on examples/construct_path_line.a2ml
+(from a path and from a Task), the arrays and reports of a Plan, the errors,
+determinism and pickling, and the writers: the CSV read back with numpy and
+the JSON with json."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import pickle
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+import a2ml
+from a2ml import Plan, PlanError, SegmentReport, Task
+
+TESTS_DIR = Path(__file__).resolve().parent
+EXAMPLES = TESTS_DIR / ".." / ".." / "examples"
+EXAMPLE = EXAMPLES / "construct_path_line.a2ml"
+
+
+@pytest.fixture(scope="module")
+def plan() -> Plan:
+    return a2ml.plan(EXAMPLE)
+
+
+def assert_grid(t: np.ndarray[Any, np.dtype[np.float64]], rate: float) -> None:
+    """Times from 0 in steps of 1 / rate, strictly increasing, and the plan's
+    end as the last sample (a shorter last step)."""
+    assert t[0] == 0.0
+    steps = np.diff(t)
+    assert np.all(steps > 0.0)
+    np.testing.assert_allclose(steps[:-1], 1.0 / rate, rtol=0.0, atol=1e-9)
+    assert steps[-1] <= 1.0 / rate + 1e-9
+    np.testing.assert_allclose(t[:-1], np.arange(len(t) - 1) / rate, rtol=0.0, atol=1e-9)
+
+
+def assert_same_plan(a: Plan, b: Plan) -> None:
+    """Bit-identical arrays and equal reports, QP timings aside."""
+    for name in ("t", "q", "qd", "wrist_reference"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+    assert a.joint_names == b.joint_names
+    assert a.rate == b.rate
+    assert a.warnings == b.warnings
+    assert a.reached == b.reached
+    assert len(a.segments) == len(b.segments)
+    for x, y in zip(a.segments, b.segments):
+        dx, dy = x.to_dict(), y.to_dict()
+        del dx["qp"], dy["qp"]
+        assert dx == dy
+
+
+def test_plan_from_a_path(plan: Plan) -> None:
+    task = a2ml.load(EXAMPLE)
+    n = len(plan.t)
+    assert n > 1
+    assert plan.t.dtype == np.float64 and plan.t.shape == (n,)
+    assert plan.q.dtype == np.float64 and plan.q.shape == (n, 7)
+    assert plan.qd.dtype == np.float64 and plan.qd.shape == (n, 7)
+    assert plan.rate == task.settings["rate"] == 100.0
+    assert_grid(plan.t, plan.rate)
+    assert np.all(np.isfinite(plan.q)) and np.all(np.isfinite(plan.qd))
+    assert plan.reached
+    assert plan.warnings == []
+    assert plan.task == task
+    assert plan.task.source == EXAMPLE.read_text(encoding="utf-8")
+    assert plan.robot.name == a2ml.Robot.from_urdf(task.robot).name
+    assert plan.joint_names == plan.robot.joint_names
+    assert plan.safety_distance > 0.0
+    assert "Plan(task='lines'" in repr(plan)
+
+
+def test_q_within_the_joint_limits(plan: Plan) -> None:
+    robot = plan.robot
+    assert np.all(plan.q >= robot.lower - 1e-9)
+    assert np.all(plan.q <= robot.upper + 1e-9)
+    assert all(s.limit_margin >= -1e-9 for s in plan.segments)
+
+
+def test_the_plan_starts_at_the_task_start(plan: Plan) -> None:
+    start = plan.task.start
+    assert start is not None
+    np.testing.assert_allclose(plan.q[0], start["joints"], atol=1e-9)
+    np.testing.assert_allclose(plan.qd[0], np.zeros(7), atol=1e-9)
+
+
+def test_plan_from_a_task_is_the_same(plan: Plan) -> None:
+    """Planning is deterministic: a Task or its path, and a second run, give
+    bit-identical arrays."""
+    task = a2ml.load(EXAMPLE)
+    from_task = a2ml.plan(task)
+    assert from_task.task is task
+    assert_same_plan(from_task, plan)
+    assert_same_plan(a2ml.plan(task), from_task)
+
+
+def test_plan_from_parsed_text_and_path_types(plan: Plan) -> None:
+    text = EXAMPLE.read_text(encoding="utf-8")
+    parsed = a2ml.parse(text, EXAMPLE)
+    assert_same_plan(a2ml.plan(parsed), plan)
+    assert_same_plan(a2ml.plan(str(EXAMPLE)), plan)
+
+
+def test_plans_run_in_threads(plan: Plan) -> None:
+    """The GIL is released while planning; results do not depend on it."""
+    task = a2ml.load(EXAMPLE)
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        plans = list(pool.map(lambda _: a2ml.plan(task), range(2)))
+    for p in plans:
+        assert_same_plan(p, plan)
+
+
+def test_segment_reports(plan: Plan) -> None:
+    task = plan.task
+    segments = plan.segments
+    assert segments and all(isinstance(s, SegmentReport) for s in segments)
+    assert [s.action for s in segments][:1] == ["slide_left"]
+    names = [a["name"] for a in task.actions]
+    assert {s.action for s in segments} == set(names)
+    previous_start = -math.inf
+    for s in segments:
+        assert names[s.action_index] == s.action
+        assert s.segment >= 0
+        assert s.action_type in ("I", "II", "III", "IV", "V", "VI", "VII")
+        assert s.space in ("cpsa", "hat")
+        assert s.pattern in (1, 2, 3)
+        assert s.solver == "qp"
+        assert s.focus and set(s.focus) <= {"pw", "ow", "swivel", "os", "elbow"}
+        assert previous_start <= s.start < s.end <= plan.t[-1] + 1.0 / plan.rate
+        previous_start = s.start
+        assert s.duration > 0.0 and s.settle >= 0.0
+        expected = ["pw", "ow", "swivel"] if s.space == "cpsa" else ["os", "elbow", "ow"]
+        assert list(s.errors) == expected
+        for e in s.errors.values():
+            assert isinstance(e, a2ml.VariableError)
+            assert e.error >= 0.0 and e.within
+        assert set(s.path_errors) <= set(expected)
+        assert s.clearance is None or isinstance(s.clearance, a2ml.Clearance)
+        assert not s.stalled and s.reached
+        assert isinstance(s.qp, a2ml.QpStats)
+        assert s.qp.steps > 0 and 0 <= s.qp.clarabel_steps <= s.qp.steps
+        assert s.qp.worst_step_time >= s.qp.mean_step_time > 0.0
+        d = s.to_dict()
+        assert list(d)[:3] == ["action", "action_index", "segment"]
+        assert d["errors"] == s.errors and d["qp"] == s.qp
+    first = segments[0]
+    assert first.action_type == "I" and first.focus[0] == "pw"
+    assert repr(first).startswith("SegmentReport(action='slide_left', segment=0")
+    rise = [s for s in segments if s.action == "rise_towards_elbow_goal"]
+    assert rise and all(s.action_type == "IV" for s in rise)
+
+
+def test_wrist_reference(plan: Plan) -> None:
+    ref = plan.wrist_reference
+    assert ref.dtype == np.float64 and ref.ndim == 2 and ref.shape[1] == 4
+    assert len(ref) > 0 and np.all(np.isfinite(ref))
+    assert ref[0, 0] == 0.0 and np.all(np.diff(ref[:, 0]) >= 0.0)
+    # The first action slides the wrist 12 cm along +y with x and z held.
+    pw0 = plan.robot.centers(plan.q[0])["wrist"]
+    first = plan.segments[0]
+    during = ref[ref[:, 0] <= first.start + first.duration]
+    np.testing.assert_allclose(during[0, 1:], pw0, atol=1e-9)
+    np.testing.assert_allclose(during[-1, 1:], pw0 + [0.0, 0.12, 0.0], atol=1e-6)
+
+
+def test_rate_and_seed() -> None:
+    slow = a2ml.plan(EXAMPLE, rate=25.0, seed=3)
+    assert slow.rate == 25.0
+    assert_grid(slow.t, 25.0)
+    assert slow.reached
+
+
+def test_auto_runs_the_qp() -> None:
+    task = a2ml.load(EXAMPLE)
+    assert_same_plan(a2ml.plan(task, solver="qp"), a2ml.plan(task, solver="auto"))
+
+
+def test_solver_overrides_the_task_and_its_actions() -> None:
+    """By default each action keeps its own solver (here `rrt`, not there
+    yet); `solver=` replaces every one."""
+    path = EXAMPLES / "construct_settings.a2ml"
+    with pytest.raises(PlanError, match="`sample_based`: solver `rrt` is not available yet"):
+        a2ml.plan(path)
+    p = a2ml.plan(path, solver="qp")
+    assert p.rate == 200.0
+    assert [s.solver for s in p.segments] == ["qp"] * len(p.segments)
+
+
+def test_unavailable_solver_raises() -> None:
+    with pytest.raises(PlanError, match="not available yet") as info:
+        a2ml.plan(EXAMPLE, solver="pmp")
+    assert isinstance(info.value, a2ml.A2mlError)
+    assert "slide_left" in str(info.value)
+
+
+def test_unknown_solver_raises() -> None:
+    with pytest.raises(ValueError, match="unknown solver 'fast'"):
+        a2ml.plan(EXAMPLE, solver="fast")  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("rate", [0.0, -10.0, math.nan, math.inf])
+def test_invalid_rate_raises(rate: float) -> None:
+    with pytest.raises(ValueError, match="invalid output rate"):
+        a2ml.plan(EXAMPLE, rate=rate)
+
+
+def test_bad_arguments_raise(tmp_path: Path) -> None:
+    with pytest.raises(TypeError, match="a2ml.Task or a path"):
+        a2ml.plan(42)  # type: ignore[arg-type]
+    with pytest.raises(FileNotFoundError):
+        a2ml.plan(tmp_path / "missing.a2ml")
+    bad = tmp_path / "bad.a2ml"
+    bad.write_text("task broken {", encoding="utf-8")
+    with pytest.raises(a2ml.ParseError):
+        a2ml.plan(bad)
+
+
+def test_a_bad_robot_file_raises_urdf_error(tmp_path: Path) -> None:
+    # The parser checks that the file exists; what it holds is checked when planning.
+    urdf = tmp_path / "not_an_arm.urdf"
+    urdf.write_text('<robot name="stick"><link name="a"/></robot>', encoding="utf-8")
+    text = EXAMPLE.read_text(encoding="utf-8").replace(
+        "../robots/coman_right_arm.urdf", urdf.as_posix()
+    )
+    with pytest.raises(a2ml.UrdfError):
+        a2ml.plan(a2ml.parse(text))
+
+
+def test_decompose_errors_keep_their_class() -> None:
+    text = EXAMPLE.read_text(encoding="utf-8")
+    no_start = "\n".join(line for line in text.splitlines() if not line.startswith("start"))
+    with pytest.raises(a2ml.DecomposeError):
+        a2ml.plan(a2ml.parse(no_start, EXAMPLE))
+
+
+def test_a_given_robot_is_used(plan: Plan) -> None:
+    robot = plan.robot
+    again = a2ml.plan(plan.task, robot=robot)
+    assert again.robot is robot
+    assert_same_plan(again, plan)
+
+
+def test_pickle_round_trip(plan: Plan) -> None:
+    back = pickle.loads(pickle.dumps(plan))
+    assert isinstance(back, Plan)
+    assert_same_plan(back, plan)
+    assert back.segments == plan.segments  # QP timings included
+    assert back.safety_distance == plan.safety_distance
+    assert back.task == plan.task and back.task.source == plan.task.source
+    assert back.robot.name == plan.robot.name
+    report = plan.segments[-1]
+    assert pickle.loads(pickle.dumps(report)) == report
+    assert report != plan.segments[0]
+
+
+def test_an_unpickled_plan_writes_the_same_files(plan: Plan, tmp_path: Path) -> None:
+    back = pickle.loads(pickle.dumps(plan))
+    plan.to_json(tmp_path / "a.json")
+    back.to_json(tmp_path / "b.json")
+    assert (tmp_path / "a.json").read_bytes() == (tmp_path / "b.json").read_bytes()
+
+
+def test_csv_round_trip(plan: Plan, tmp_path: Path) -> None:
+    path = tmp_path / "plan.csv"
+    plan.to_csv(path)
+    with path.open(encoding="utf-8") as f:
+        header = f.readline().strip().split(",")
+    names = plan.joint_names
+    assert header == ["t"] + [f"{n}_pos" for n in names] + [f"{n}_vel" for n in names]
+    table = np.loadtxt(path, delimiter=",", skiprows=1)
+    assert table.shape == (len(plan.t), 15)
+    # Numbers are written in a form that reads back exactly.
+    np.testing.assert_array_equal(table[:, 0], plan.t)
+    np.testing.assert_array_equal(table[:, 1:8], plan.q)
+    np.testing.assert_array_equal(table[:, 8:15], plan.qd)
+
+
+def test_json(plan: Plan, tmp_path: Path) -> None:
+    path = tmp_path / "plan.json"
+    plan.to_json(os.fspath(path))
+    doc = json.loads(path.read_text(encoding="utf-8"))
+    assert doc["robot"] == plan.robot.name
+    assert doc["rate"] == plan.rate
+    assert doc["joint_names"] == plan.joint_names
+    assert len(doc["segments"]) == len(plan.segments)
+    assert doc["warnings"] == plan.warnings
+
+
+def test_a_failed_write_leaves_no_file(plan: Plan, tmp_path: Path) -> None:
+    target = tmp_path / "missing" / "out.mcap"
+    with pytest.raises(OSError):
+        plan.write_mcap(target)
+    assert not target.exists()
+    assert list(tmp_path.iterdir()) == []
+
