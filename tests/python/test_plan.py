@@ -1,7 +1,8 @@
 """The Python API of planning: a2ml.plan on examples/construct_path_line.a2ml
 (from a path and from a Task), the arrays and reports of a Plan, the errors,
-determinism and pickling, and the writers: the CSV read back with numpy and
-the JSON with json."""
+determinism and pickling, and the writers: the CSV read back with numpy, the
+JSON with json, and the MCAP with the independent reader of the ``mcap``
+package (channels, schemas, counts, log times, payloads, attachments)."""
 
 from __future__ import annotations
 
@@ -9,12 +10,14 @@ import json
 import math
 import os
 import pickle
+from collections import defaultdict
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from mcap.reader import make_reader
 
 import a2ml
 from a2ml import Plan, PlanError, SegmentReport, Task
@@ -22,6 +25,16 @@ from a2ml import Plan, PlanError, SegmentReport, Task
 TESTS_DIR = Path(__file__).resolve().parent
 EXAMPLES = TESTS_DIR / ".." / ".." / "examples"
 EXAMPLE = EXAMPLES / "construct_path_line.a2ml"
+
+# The topics the project requires of every MCAP file, with their schemas.
+SCHEMAS = {
+    "/joint_states": "a2ml.JointState",
+    "/tf": "foxglove.FrameTransforms",
+    "/scene": "foxglove.SceneUpdate",
+    "/wrist_path": "foxglove.SceneUpdate",
+    "/a2ml/state": "a2ml.State",
+    "/a2ml/segments": "a2ml.Segment",
+}
 
 
 @pytest.fixture(scope="module")
@@ -298,3 +311,112 @@ def test_a_failed_write_leaves_no_file(plan: Plan, tmp_path: Path) -> None:
     assert not target.exists()
     assert list(tmp_path.iterdir()) == []
 
+
+# --- MCAP, read back with the mcap package's reader -------------------------
+
+
+class Recording:
+    """Everything in an MCAP file, read once with the independent reader."""
+
+    def __init__(self, path: Path) -> None:
+        self.messages: dict[str, list[tuple[int, Any]]] = defaultdict(list)
+        self.schemas: dict[str, tuple[str, str, Any]] = {}
+        self.encodings: dict[str, str] = {}
+        with path.open("rb") as f:
+            reader = make_reader(f)
+            summary = reader.get_summary()
+            assert summary is not None
+            self.summary = summary
+            for schema, channel, message in reader.iter_messages(log_time_order=False):
+                assert schema is not None
+                topic = channel.topic
+                self.schemas[topic] = (schema.name, schema.encoding, json.loads(schema.data))
+                self.encodings[topic] = channel.message_encoding
+                self.messages[topic].append((message.log_time, json.loads(message.data)))
+            f.seek(0)
+            self.attachments = {a.name: a for a in make_reader(f).iter_attachments()}
+            f.seek(0)
+            self.metadata = {m.name: m.metadata for m in make_reader(f).iter_metadata()}
+
+
+@pytest.fixture(scope="module")
+def recording(plan: Plan, tmp_path_factory: pytest.TempPathFactory) -> Recording:
+    path = tmp_path_factory.mktemp("mcap") / "out.mcap"
+    plan.write_mcap(path)
+    return Recording(path)
+
+
+def test_mcap_channels_and_schemas(recording: Recording) -> None:
+    topics = {c.topic for c in recording.summary.channels.values()}
+    assert set(SCHEMAS) <= topics
+    for topic, name in SCHEMAS.items():
+        schema_name, encoding, body = recording.schemas[topic]
+        assert schema_name == name, topic
+        assert encoding == "jsonschema"
+        assert isinstance(body, dict) and body
+        assert recording.encodings[topic] == "json"
+    for channel in recording.summary.channels.values():
+        assert channel.message_encoding == "json"
+
+
+def test_mcap_message_counts(plan: Plan, recording: Recording) -> None:
+    samples = len(plan.t)
+    counts = {topic: len(ms) for topic, ms in recording.messages.items()}
+    assert counts["/joint_states"] == samples
+    assert counts["/tf"] == samples
+    assert counts["/a2ml/state"] == samples
+    assert counts["/a2ml/segments"] == len(plan.segments)
+    assert counts["/scene"] >= 1
+    assert counts["/wrist_path"] >= 1
+    statistics = recording.summary.statistics
+    assert statistics is not None
+    assert statistics.message_count == sum(counts.values())
+
+
+def test_mcap_log_times(plan: Plan, recording: Recording) -> None:
+    for topic, messages in recording.messages.items():
+        times = [t for t, _ in messages]
+        assert times == sorted(times), topic
+    joint_times = np.array([t for t, _ in recording.messages["/joint_states"]])
+    np.testing.assert_array_equal(joint_times, np.round(plan.t * 1e9).astype(np.int64))
+    assert np.all(np.diff(joint_times) > 0)
+    segment_times = [t for t, _ in recording.messages["/a2ml/segments"]]
+    assert segment_times == [round(s.start * 1e9) for s in plan.segments]
+
+
+def test_mcap_payloads(plan: Plan, recording: Recording) -> None:
+    states = [m for _, m in recording.messages["/joint_states"]]
+    assert all(m["name"] == plan.joint_names for m in states)
+    np.testing.assert_array_equal([m["position"] for m in states], plan.q)
+    np.testing.assert_array_equal([m["velocity"] for m in states], plan.qd)
+    segments = [m for _, m in recording.messages["/a2ml/segments"]]
+    assert [(m["action"], m["segment"]) for m in segments] == [
+        (s.action, s.segment) for s in plan.segments
+    ]
+    for _, tf in recording.messages["/tf"]:
+        assert tf["transforms"]
+    assert recording.messages["/scene"][0][1]["entities"] is not None
+
+
+def test_mcap_attachments_and_metadata(plan: Plan, recording: Recording) -> None:
+    task = plan.task
+    source = recording.attachments[f"{task.name}.a2ml"]
+    assert source.data == EXAMPLE.read_bytes()
+    assert source.media_type == "text/plain"
+    urdf = recording.attachments[f"{plan.robot.name}.urdf"]
+    assert urdf.data == Path(task.robot).read_bytes()
+    assert len(recording.attachments) == 2
+    metadata = recording.metadata["a2ml"]
+    assert metadata["task"] == task.name
+    assert metadata["robot"] == plan.robot.name
+    assert metadata["reached"] == "true"
+
+
+def test_mcap_of_a_parsed_task_attaches_its_text(tmp_path: Path) -> None:
+    text = EXAMPLE.read_text(encoding="utf-8") + "\n# parsed, not loaded\n"
+    p = a2ml.plan(a2ml.parse(text, EXAMPLE), rate=20.0)
+    path = tmp_path / "parsed.mcap"
+    p.write_mcap(path)
+    recording = Recording(path)
+    assert recording.attachments["lines.a2ml"].data == text.encode("utf-8")
+    assert len(recording.messages["/joint_states"]) == len(p.t)
