@@ -44,6 +44,7 @@ task push {
   action slide {
     pre { empty } add { done }
     path Pw line [0, 1, 0] 20 cm, Ow hold, θsw hold : hard
+    contact { table }
     solver qp
   }
   action turn explicit {
@@ -122,6 +123,7 @@ def test_constraint_action_with_priorities(task: Task) -> None:
     assert drop["kind"] == "constraints"
     assert (drop["name"], drop["description"]) == ("drop", "Drop what is in the hand")
     assert (drop["pre"], drop["add"], drop["del"]) == (["holding"], ["empty"], ["holding"])
+    assert drop["contact"] == []
     assert drop["solver"] is None and drop["path"] is None
     assert drop["duration"] == 2.0
     goal = drop["goal"]
@@ -137,6 +139,7 @@ def test_constraint_action_with_priorities(task: Task) -> None:
 def test_path_action_in_si(task: Task) -> None:
     slide = task.actions[1]
     assert slide["kind"] == "constraints" and slide["solver"] == "qp"
+    assert slide["contact"] == ["table"]
     assert slide["goal"] is None and slide["duration"] is None
     path = slide["path"]
     assert path["space"] == "cpsa" and path["hard"] is True

@@ -373,8 +373,8 @@ fn segment<'py>(py: Python<'py>, s: &Segment) -> PyResult<Dict<'py>> {
     Ok(d)
 }
 
-/// The STRIPS part, `solver` and `kind`, then for `"constraints"` the keys
-/// `goal`, `path` and `duration`, for `"explicit"` the key `segments`.
+/// The STRIPS part, `contact`, `solver` and `kind`, then for `"constraints"`
+/// the keys `goal`, `path` and `duration`, for `"explicit"` the key `segments`.
 fn action<'py>(py: Python<'py>, a: &Action) -> PyResult<Dict<'py>> {
     let d = PyDict::new(py);
     d.set_item("name", &a.name)?;
@@ -382,6 +382,7 @@ fn action<'py>(py: Python<'py>, a: &Action) -> PyResult<Dict<'py>> {
     d.set_item("pre", &a.pre)?;
     d.set_item("add", &a.add)?;
     d.set_item("del", &a.del)?;
+    d.set_item("contact", &a.contact)?;
     d.set_item("solver", a.solver.map(|s| s.name()))?;
     match &a.body {
         ActionBody::Constraints { goal, path, duration } => {

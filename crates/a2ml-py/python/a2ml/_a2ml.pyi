@@ -328,7 +328,8 @@ class Task:
     def actions(self) -> list[dict[str, Any]]:
         """The actions in written order. Each dict has ``name``,
         ``description`` (str or None), ``pre``, ``add``, ``del`` (lists of
-        facts), ``solver`` (str or None) and ``kind``:
+        facts), ``contact`` (names of the obstacles it may touch), ``solver``
+        (str or None) and ``kind``:
 
         - ``"constraints"``: ``goal`` (None or ``{"primary": {variable:
           value}, "secondary": {variable: value} | None}``), ``path`` (None or
