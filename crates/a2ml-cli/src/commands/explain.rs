@@ -16,8 +16,8 @@ use a2ml_core::decompose::{
     self, DecomposeOptions, Decomposition, OptReport, PlannedAction, PlannedSegment,
 };
 use a2ml_core::language::{
-    self, ActionBody, Axis, BodyAxis, Goal, GoalConstraint, LanguageError, PathConstraint,
-    PathFeature, Primitive, PrimitiveConstraint, Space, Target, Task, Variable,
+    ActionBody, Axis, BodyAxis, Goal, GoalConstraint, PathConstraint, PathFeature, Primitive,
+    PrimitiveConstraint, Space, Target, Task, Variable,
 };
 use a2ml_core::math::{DOF, JointVector, Real, Rotation3, Vector3};
 
@@ -56,18 +56,7 @@ pub struct ExplainArgs {
 /// [`CliError::Input`] when the task is invalid (its diagnostics go to
 /// stderr first), the robot is unusable, or the decomposition fails.
 pub fn run(args: &ExplainArgs) -> Result<(), CliError> {
-    let task = match language::load(&args.file) {
-        Ok(task) => task,
-        Err(error @ LanguageError::Io { .. }) => return Err(CliError::Io(error.to_string())),
-        Err(LanguageError::Invalid(diagnostics)) => {
-            output::report(&diagnostics.to_string());
-            return Err(CliError::Input(format!(
-                "{} is not a valid task ({})",
-                args.file.display(),
-                output::count(diagnostics.items.len(), "problem")
-            )));
-        }
-    };
+    let (task, _) = super::load_task(&args.file)?;
     let robot = Robot::from_urdf_file(&task.robot)?;
     let decomposition = decompose::decompose(&robot, &task, &DecomposeOptions::default())
         .map_err(|e| CliError::Input(format!("{}: {e}", args.file.display())))?;

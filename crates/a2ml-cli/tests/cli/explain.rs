@@ -4,13 +4,7 @@ use std::path::PathBuf;
 
 use serde_json::Value;
 
-use crate::{a2ml, keys, robot_path, sorted, stderr, stdout};
-
-/// A file of the repository's `examples/`.
-fn example_path(name: &str) -> String {
-    let path: PathBuf = [env!("CARGO_MANIFEST_DIR"), "..", "..", "examples", name].iter().collect();
-    path.to_string_lossy().into_owned()
-}
+use crate::{a2ml, example_path, keys, robot_path, sorted, stderr, stdout};
 
 /// Runs `a2ml explain <example>`, checks exit 0 and returns stdout.
 fn explain_text(example: &str) -> String {

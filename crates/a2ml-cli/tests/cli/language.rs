@@ -1,23 +1,8 @@
 //! `a2ml check` and `a2ml fmt` on the task files of `tests/fixtures`.
 
 use std::fs;
-use std::path::PathBuf;
 
-use crate::{a2ml, stderr, stdout};
-
-/// A fixture's path, as the binary is given it.
-fn fixture(name: &str) -> String {
-    let path: PathBuf = [env!("CARGO_MANIFEST_DIR"), "tests", "fixtures", name].iter().collect();
-    path.to_string_lossy().into_owned()
-}
-
-/// A fresh, empty folder for one test's files.
-fn scratch(test: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("language").join(test);
-    let _ = fs::remove_dir_all(&dir);
-    fs::create_dir_all(&dir).expect("scratch folder");
-    dir
-}
+use crate::{a2ml, fixture, scratch, stderr, stdout};
 
 fn read(path: &str) -> String {
     fs::read_to_string(path).expect("readable file")
@@ -121,7 +106,7 @@ fn fmt_check() {
 
 #[test]
 fn fmt_write_rewrites_in_place() {
-    let dir = scratch("fmt_write");
+    let dir = scratch("language", "fmt_write");
     let path = dir.join("task.a2ml");
     fs::copy(fixture("valid.a2ml"), &path).expect("copy");
     let path = path.to_string_lossy().into_owned();
@@ -160,7 +145,7 @@ fn fmt_check_passes_on_a_canonical_commented_file() {
 
 #[test]
 fn fmt_write_keeps_comments() {
-    let dir = scratch("fmt_write_comments");
+    let dir = scratch("language", "fmt_write_comments");
     let path = dir.join("task.a2ml");
     fs::copy(fixture("commented_untidy.a2ml"), &path).expect("copy");
     let path = path.to_string_lossy().into_owned();
@@ -219,7 +204,7 @@ fn fmt_exit_codes() {
 fn fmt_write_through_a_link_keeps_the_link_and_permissions() {
     use std::os::unix::fs::{PermissionsExt, symlink};
 
-    let dir = scratch("fmt_write_link");
+    let dir = scratch("language", "fmt_write_link");
     let target = dir.join("real.a2ml");
     fs::copy(fixture("valid.a2ml"), &target).expect("copy");
     fs::set_permissions(&target, fs::Permissions::from_mode(0o640)).expect("chmod");

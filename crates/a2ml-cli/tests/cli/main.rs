@@ -5,6 +5,7 @@ mod explain;
 mod language;
 mod robot;
 
+use std::fs;
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -12,6 +13,26 @@ use std::process::{Command, Output};
 fn robot_path(name: &str) -> String {
     let path: PathBuf = [env!("CARGO_MANIFEST_DIR"), "..", "..", "robots", name].iter().collect();
     path.to_string_lossy().into_owned()
+}
+
+/// A file of the repository's `examples/`.
+fn example_path(name: &str) -> String {
+    let path: PathBuf = [env!("CARGO_MANIFEST_DIR"), "..", "..", "examples", name].iter().collect();
+    path.to_string_lossy().into_owned()
+}
+
+/// A file of this crate's `tests/fixtures`, as the binary is given it.
+fn fixture(name: &str) -> String {
+    let path: PathBuf = [env!("CARGO_MANIFEST_DIR"), "tests", "fixtures", name].iter().collect();
+    path.to_string_lossy().into_owned()
+}
+
+/// A fresh, empty folder for one test's files, under `area` (the test's module).
+fn scratch(area: &str, test: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(area).join(test);
+    let _ = fs::remove_dir_all(&dir);
+    fs::create_dir_all(&dir).expect("scratch folder");
+    dir
 }
 
 /// Runs the binary.
