@@ -161,7 +161,7 @@ struct Solver<'a> {
 
 impl Solver<'_> {
     fn action(&mut self, action: &PlannedAction) -> Result<(), SolveError> {
-        let scene = CollisionScene::new(&self.task.scene);
+        let scene = CollisionScene::new(&self.task.action_scene(action.index));
         let action_start = self.whole.as_ref().map_or(0.0, Trajectory::end);
         let mut joined: Option<Trajectory> = None;
         let mut last: Option<(Real, Real)> = None; // (start, duration) of the previous segment
