@@ -121,7 +121,9 @@ pub fn projector(n: &Vector3) -> Matrix3 {
 
 /// The solutions θ in (-π, π] of `a cos θ + b sin θ = c` (none, one or two).
 pub fn solve_trig(a: Real, b: Real, c: Real) -> Vec<Real> {
-    let rho = a.hypot(b);
+    // Coefficients here are lengths and products of arm dimensions: no overflow risk, and
+    // sqrt is several times faster than hypot.
+    let rho = (a * a + b * b).sqrt();
     if rho < 1e-14 {
         return Vec::new();
     }
