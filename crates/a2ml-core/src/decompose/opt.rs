@@ -197,6 +197,9 @@ struct Search<'a> {
     options: &'a OptOptions,
     scene: Option<&'a CollisionScene>,
     evaluations: usize,
+    /// Whether each evaluation checks the points along a hard path, or only the end
+    /// (the first pass; its winner is checked afterwards).
+    check_path: bool,
 }
 
 fn dims(v: Variable) -> usize {
@@ -317,17 +320,24 @@ impl Search<'_> {
         if !self.clear(&q) {
             return None;
         }
-        // Only a hard path must stay reachable all along; elsewhere the
-        // solver chooses the way and only the end has to be reachable.
-        let checks = if self.path.is_some_and(|p| p.hard) { self.options.path_checks } else { 0 };
-        for k in 1..=checks {
-            let f = k as Real / (self.options.path_checks + 1) as Real;
-            let mid = ArmState::from_space(self.robot, self.space, &self.values(x, f))?;
-            // Only reachability along the way: how the arm gets round an
-            // obstacle between the ends is the solver's choice (RRT).
-            ik_cpsa(self.robot, &mid.cpsa, Some(&q)).ok()?;
+        if self.check_path && !self.path_reachable(x, &q) {
+            return None;
         }
         Some((end, q))
+    }
+
+    /// Whether every checked point along a hard path has IK within the limits. Only a hard
+    /// path must stay reachable all along; elsewhere the solver chooses the way and only the
+    /// end has to be reachable.
+    fn path_reachable(&self, x: &[Real], q: &JointVector) -> bool {
+        let checks = if self.path.is_some_and(|p| p.hard) { self.options.path_checks } else { 0 };
+        (1..=checks).all(|k| {
+            let f = k as Real / (self.options.path_checks + 1) as Real;
+            // Only reachability along the way: how the arm gets round an
+            // obstacle between the ends is the solver's choice (RRT).
+            ArmState::from_space(self.robot, self.space, &self.values(x, f))
+                .is_some_and(|mid| ik_cpsa(self.robot, &mid.cpsa, Some(q)).is_ok())
+        })
     }
 
     /// Whether the arm at `q` keeps the clearance from the scene and itself.
@@ -510,19 +520,43 @@ impl Search<'_> {
         if self.free == [Variable::Swivel] && self.sized.is_empty() {
             starts.extend(self.swivel_starts());
         }
-        let mut best: Option<(Vec<Real>, ArmState, JointVector, Real)> = None;
-        for x0 in starts {
-            if let Some(found) = self.minimise(x0) {
-                if best.as_ref().is_none_or(|b| found.3 < b.3) {
-                    best = Some(found);
-                }
-            }
-            if best.as_ref().is_some_and(|b| b.3 < self.options.tolerance) {
-                break;
+        // Checking the points along a hard path costs path_checks IKs per evaluation; the
+        // optimum usually keeps the path reachable anyway. So search checking the ends only,
+        // take the best result whose path checks out, and search again with every evaluation
+        // checked only when none does.
+        let hard = self.path.is_some_and(|p| p.hard) && self.options.path_checks > 0;
+        self.check_path = !hard;
+        let mut found = self.multistart(&starts);
+        if hard {
+            found.retain(|(x, _, q, _)| self.path_reachable(x, q));
+            if found.is_empty() {
+                self.check_path = true;
+                found = self.multistart(&starts);
             }
         }
-        let (x, state, q, residual) = best.ok_or(OptError::Infeasible)?;
+        let (x, state, q, residual) = found.into_iter().next().ok_or(OptError::Infeasible)?;
         Ok(OptSolution { sizes: self.sizes(&x), state, q, residual, evaluations: self.evaluations })
+    }
+
+    /// The local optimum from each start, best first, stopping at the first that meets the
+    /// tolerance.
+    fn multistart(
+        &mut self,
+        starts: &[Vec<Real>],
+    ) -> Vec<(Vec<Real>, ArmState, JointVector, Real)> {
+        let mut found = Vec::new();
+        for x0 in starts {
+            if let Some(local) = self.minimise(x0.clone()) {
+                let done = local.3 < self.options.tolerance;
+                found.push(local);
+                if done {
+                    break;
+                }
+            }
+        }
+        // Stable: among equal residuals the earlier start wins, as before.
+        found.sort_by(|a, b| a.3.total_cmp(&b.3));
+        found
     }
 
     /// θsw offsets spread over the feasible swivel intervals at the fixed
@@ -627,6 +661,7 @@ pub fn opt1(
         options,
         scene,
         evaluations: 0,
+        check_path: true,
     }
     .solve()
 }
@@ -682,6 +717,7 @@ pub fn opt2(
         options,
         scene,
         evaluations: 0,
+        check_path: true,
     }
     .solve()
 }
