@@ -6,6 +6,7 @@ use clap::{Parser, Subcommand};
 use crate::commands::check::CheckArgs;
 use crate::commands::explain::ExplainArgs;
 use crate::commands::fmt::FmtArgs;
+use crate::commands::plan::PlanArgs;
 use crate::commands::robot::RobotArgs;
 
 /// Plans human-like motions for 7-DoF anthropomorphic arms from A2ML tasks.
@@ -19,8 +20,10 @@ Examples:
   a2ml check examples/*.a2ml
   a2ml fmt --write task.a2ml
   a2ml explain examples/type_iv_forward_bar.a2ml
+  a2ml plan examples/construct_path_line.a2ml -o lines.mcap
 
-Exit codes: 0 success, 1 I/O error, 2 invalid input.")]
+Exit codes: 0 success, 1 I/O error, 2 invalid input, 3 a goal missed (plan
+written), 4 planning failed.")]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]
@@ -38,4 +41,6 @@ pub enum Commands {
     Fmt(FmtArgs),
     /// Show how a task decomposes: actions, types, segments, primitives, Opt1/Opt2.
     Explain(ExplainArgs),
+    /// Plan a task's motion and write it as MCAP (for Foxglove), CSV or JSON.
+    Plan(PlanArgs),
 }

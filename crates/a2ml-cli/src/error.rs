@@ -1,5 +1,6 @@
-//! The CLI's error: a message and whether it came from I/O or from the input,
-//! which decides the exit code.
+//! The CLI's error: a message and what kind of failure it reports, which
+//! decides the exit code (0 success, 1 I/O, 2 invalid input, 3 a goal missed,
+//! 4 planning failed).
 
 use std::fmt;
 use std::process::ExitCode;
@@ -14,6 +15,13 @@ pub enum CliError {
     /// The input is invalid: bad URDF, no 7-DoF chain, unknown link,
     /// bad argument, a task file that is not valid (exit code 2).
     Input(String),
+    /// A plan was made and written but misses a goal beyond tolerance
+    /// (exit code 3): the results are usable, yet not what was asked.
+    Missed(String),
+    /// The solver could not produce a motion for a valid task: a QP step
+    /// without solution, a singular state on the way (exit code 4). Nothing
+    /// is written.
+    Planning(String),
 }
 
 impl CliError {
@@ -22,6 +30,8 @@ impl CliError {
         match self {
             Self::Io(_) => ExitCode::from(1),
             Self::Input(_) => ExitCode::from(2),
+            Self::Missed(_) => ExitCode::from(3),
+            Self::Planning(_) => ExitCode::from(4),
         }
     }
 }
@@ -29,7 +39,10 @@ impl CliError {
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::Io(message) | Self::Input(message) => f.write_str(message),
+            Self::Io(message)
+            | Self::Input(message)
+            | Self::Missed(message)
+            | Self::Planning(message) => f.write_str(message),
         }
     }
 }

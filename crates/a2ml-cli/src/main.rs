@@ -1,6 +1,7 @@
 //! The `a2ml` command line: parses the arguments, runs the subcommand and
 //! turns the outcome into an exit code (0 success, 1 I/O error, 2 invalid
-//! input). Everything else lives in [`commands`] and the core library.
+//! input, 3 a goal missed, 4 planning failed; see [`error::CliError`]).
+//! Everything else lives in [`commands`] and the core library.
 
 mod args;
 mod commands;

@@ -71,17 +71,19 @@ enum Row {
 }
 
 /// A plain-text table: the leading columns left-aligned (one unless told),
-/// the others right-aligned, columns two spaces apart, every line but the
-/// titles indented by two spaces. Titles let several sections share columns.
+/// and any others marked so, the rest right-aligned; columns two spaces
+/// apart, every line but the titles indented by two spaces. Titles let
+/// several sections share columns.
 pub struct Table {
     header: Option<Vec<String>>,
     left: usize,
+    also_left: Vec<usize>,
     rows: Vec<Row>,
 }
 
 impl Default for Table {
     fn default() -> Self {
-        Self { header: None, left: 1, rows: Vec::new() }
+        Self { header: None, left: 1, also_left: Vec::new(), rows: Vec::new() }
     }
 }
 
@@ -99,6 +101,12 @@ impl Table {
     /// Left-aligns the first `n` columns instead of only the first.
     pub fn left_columns(mut self, n: usize) -> Self {
         self.left = n;
+        self
+    }
+
+    /// Left-aligns these columns (0-based) too: text among numbers.
+    pub fn left_aligned(mut self, columns: impl IntoIterator<Item = usize>) -> Self {
+        self.also_left.extend(columns);
         self
     }
 
@@ -156,7 +164,7 @@ impl Table {
                 if i > 0 {
                     text.push_str("  ");
                 }
-                if i < self.left {
+                if i < self.left || self.also_left.contains(&i) {
                     text.push_str(cell);
                     text.push_str(&pad);
                 } else {

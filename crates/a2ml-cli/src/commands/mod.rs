@@ -5,6 +5,7 @@
 pub mod check;
 pub mod explain;
 pub mod fmt;
+pub mod plan;
 pub mod robot;
 
 use std::path::Path;
@@ -25,6 +26,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Commands::Check(args) => check::run(&args),
         Commands::Fmt(args) => fmt::run(&args),
         Commands::Explain(args) => explain::run(&args),
+        Commands::Plan(args) => plan::run(&args),
     }
 }
 

@@ -3,6 +3,7 @@
 
 mod explain;
 mod language;
+mod plan;
 mod robot;
 
 use std::fs;

@@ -1,0 +1,403 @@
+//! `a2ml plan`: loads a task and its robot, plans it ([`solve::plan`]:
+//! decompose, solve every segment, join) and writes the result as MCAP, CSV
+//! or JSON through the core's atomic writers. Stdout gets a summary table,
+//! one row per segment, and a line of totals; stderr gets the warnings and,
+//! on a terminal, a progress bar while planning takes a while.
+
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use clap::Args;
+use clap::builder::{PossibleValuesParser, TypedValueParser};
+
+use a2ml_core::Robot;
+use a2ml_core::language::{SolverChoice, Task, Variable};
+use a2ml_core::math::Real;
+use a2ml_core::output::{self as files, OutputError};
+use a2ml_core::solve::{self, Plan, PlanOptions, Progress, SegmentReport, SolveError, Tolerance};
+
+use crate::error::CliError;
+use crate::output::{self, COARSE, Table, deg, num};
+
+/// Decimals for durations (s).
+const SECONDS: usize = 3;
+
+/// Planning shorter than this shows no progress bar: it would only flicker.
+const PROGRESS_DELAY: Duration = Duration::from_millis(300);
+
+/// Arguments of `a2ml plan`.
+#[derive(Debug, Args)]
+#[command(after_help = "\
+Examples:
+  a2ml plan examples/construct_path_line.a2ml
+  a2ml plan task.a2ml -o out.mcap --csv out.csv --json out.json
+  a2ml plan task.a2ml --solver qp --rate 250 --seed 7
+
+Without -o, --csv or --json the MCAP file goes to <FILE stem>.mcap in the
+current folder. Every file is written to a temporary file and renamed, so a
+failed run leaves no partial file.
+
+Exit codes: 0 success, 1 a file cannot be read or written, 2 the task or an
+option is not valid or the task cannot be decomposed, 3 a goal is missed
+beyond tolerance (the files are written all the same), 4 the solver failed
+on a segment (nothing is written).")]
+pub struct PlanArgs {
+    /// The task file.
+    #[arg(value_name = "FILE")]
+    pub file: PathBuf,
+    /// Write the plan as MCAP, for Foxglove [default: <FILE stem>.mcap, when
+    /// neither --csv nor --json is given].
+    #[arg(short = 'o', long = "output", value_name = "OUT.mcap")]
+    pub output: Option<PathBuf>,
+    /// Write the joint trajectory as CSV: t, then <joint>_pos and <joint>_vel.
+    #[arg(long, value_name = "OUT.csv")]
+    pub csv: Option<PathBuf>,
+    /// Write the plan as JSON: trajectory, segment reports, warnings.
+    #[arg(long, value_name = "OUT.json")]
+    pub json: Option<PathBuf>,
+    /// Solver for every segment, overriding the task's choices.
+    #[arg(long, value_name = "SOLVER", value_parser = solver_parser())]
+    pub solver: Option<SolverChoice>,
+    /// Output rate (Hz), overriding the task's `settings { rate }`.
+    #[arg(long, value_name = "HZ", value_parser = parse_rate, allow_hyphen_values = true)]
+    pub rate: Option<Real>,
+    /// Seed of the randomised solvers, overriding the task's `settings { seed }`.
+    #[arg(long, value_name = "N")]
+    pub seed: Option<u64>,
+}
+
+/// `--solver`: one of [`SolverChoice::NAMES`], listed in `--help`.
+fn solver_parser() -> impl TypedValueParser<Value = SolverChoice> {
+    PossibleValuesParser::new(SolverChoice::NAMES.map(|(name, _)| name)).map(|name| {
+        SolverChoice::NAMES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map_or(SolverChoice::Auto, |(_, solver)| *solver)
+    })
+}
+
+/// `--rate`: a positive, finite number of samples per second.
+///
+/// # Errors
+/// A message saying what the rate must be.
+fn parse_rate(text: &str) -> Result<Real, String> {
+    match text.trim().parse::<Real>() {
+        Ok(rate) if rate.is_finite() && rate > 0.0 => Ok(rate),
+        Ok(_) => Err("the rate must be positive and finite (Hz)".to_owned()),
+        Err(_) => Err("not a number (Hz)".to_owned()),
+    }
+}
+
+/// The kinds of file `a2ml plan` writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Format {
+    Mcap,
+    Csv,
+    Json,
+}
+
+/// Runs `a2ml plan`.
+///
+/// # Errors
+/// [`CliError::Io`] when the task or robot cannot be read or an output not
+/// written; [`CliError::Input`] for an invalid task (diagnostics on stderr
+/// first), an unusable robot, a task that does not decompose or a solver that
+/// does not exist yet; [`CliError::Planning`] when a segment's solve fails;
+/// [`CliError::Missed`] when the plan, written all the same, misses a goal.
+pub fn run(args: &PlanArgs) -> Result<(), CliError> {
+    let outputs = outputs(args);
+    for (_, path) in &outputs {
+        check_folder(path)?;
+    }
+    let (mut task, source) = super::load_task(&args.file)?;
+    if let Some(seed) = args.seed {
+        task.settings.seed = seed;
+    }
+    let robot = Robot::from_urdf_file(&task.robot)?;
+    let options = PlanOptions { solver: args.solver, rate: args.rate, ..PlanOptions::default() };
+
+    let started = Instant::now();
+    let mut bar = ProgressBar::new(started);
+    let result = solve::plan_with_progress(&robot, &task, &options, &mut |p| bar.update(p));
+    bar.clear();
+    let plan = result.map_err(|e| solve_error(&args.file, e))?;
+    let planning_time = started.elapsed();
+
+    for warning in &plan.warnings {
+        output::warn(warning);
+    }
+    let tolerance = options.qp.tolerance;
+    output::print(&summary(&args.file, &robot, &plan, &tolerance, planning_time))?;
+    for (format, path) in &outputs {
+        write(*format, path, &robot, &task, &source, &plan).map_err(output_error)?;
+        output::print(&format!("wrote  {}\n", path.display()))?;
+    }
+
+    let missed = plan.segments.iter().filter(|s| !s.reached).count();
+    if missed > 0 {
+        return Err(CliError::Missed(format!(
+            "{missed} of {} missed {} beyond tolerance; the plan was written all the same",
+            output::count(plan.segments.len(), "segment"),
+            if missed == 1 { "its goal" } else { "their goals" }
+        )));
+    }
+    Ok(())
+}
+
+/// The files to write: those asked for, else `<stem>.mcap` in the current folder.
+fn outputs(args: &PlanArgs) -> Vec<(Format, PathBuf)> {
+    let asked =
+        [(Format::Mcap, &args.output), (Format::Csv, &args.csv), (Format::Json, &args.json)];
+    let mut outputs: Vec<(Format, PathBuf)> =
+        asked.iter().filter_map(|(f, p)| p.as_ref().map(|p| (*f, p.clone()))).collect();
+    if outputs.is_empty() {
+        let stem = args.file.file_stem().map_or_else(|| "plan".into(), ToOwned::to_owned);
+        outputs.push((Format::Mcap, PathBuf::from(stem).with_extension("mcap")));
+    }
+    outputs
+}
+
+/// Fails early, before a long plan, when an output's folder does not exist.
+///
+/// # Errors
+/// [`CliError::Io`] naming the output and its folder.
+fn check_folder(path: &Path) -> Result<(), CliError> {
+    match path.parent() {
+        Some(folder) if !folder.as_os_str().is_empty() && !folder.is_dir() => Err(CliError::Io(
+            format!("cannot write {}: there is no folder {}", path.display(), folder.display()),
+        )),
+        _ => Ok(()),
+    }
+}
+
+fn write(
+    format: Format,
+    path: &Path,
+    robot: &Robot,
+    task: &Task,
+    source: &str,
+    plan: &Plan,
+) -> Result<(), OutputError> {
+    match format {
+        Format::Mcap => files::write_mcap(path, robot, task, source, plan),
+        Format::Csv => files::write_csv(path, robot, plan),
+        Format::Json => files::write_json(path, robot, task, plan),
+    }
+}
+
+/// An output that cannot be written is an I/O failure, whatever the cause:
+/// an encoding failure would be a bug, but still a file not written.
+fn output_error(error: OutputError) -> CliError {
+    CliError::Io(error.to_string())
+}
+
+/// The exit code of each way planning fails: the input (2) or the solver (4).
+fn solve_error(file: &Path, error: SolveError) -> CliError {
+    let message = format!("{}: {error}", file.display());
+    match error {
+        SolveError::Decompose(_)
+        | SolveError::InvalidRate { .. }
+        | SolveError::UnsupportedSolver { .. } => CliError::Input(message),
+        SolveError::Reference { .. } | SolveError::Qp { .. } | SolveError::Trajectory(_) => {
+            CliError::Planning(message)
+        }
+    }
+}
+
+/// The summary: the task, one row per segment, then the totals.
+fn summary(
+    file: &Path,
+    robot: &Robot,
+    plan: &Plan,
+    tolerance: &Tolerance,
+    planning_time: Duration,
+) -> String {
+    let mut head = Table::new();
+    head.title(format!("plan {}", plan.task));
+    head.note("file", file.display().to_string());
+    head.note("robot", robot.name.clone());
+    let mut out = String::new();
+    head.render(&mut out);
+
+    let mut table = Table::with_header([
+        "action",
+        "segment",
+        "type",
+        "pattern",
+        "space",
+        "solver",
+        "duration (s)",
+        "goal error",
+        "clearance (mm)",
+        "limit margin (°)",
+        "status",
+    ])
+    .left_aligned([2, 4, 5, 7, 10]);
+    table.title("segments");
+    for s in &plan.segments {
+        table.row(
+            s.action.clone(),
+            [
+                (s.segment + 1).to_string(),
+                s.action_type.map_or_else(|| "-".to_owned(), |t| t.numeral().to_owned()),
+                s.pattern.number().to_string(),
+                s.space.name().to_owned(),
+                s.solver.name().to_owned(),
+                num(s.end - s.start, SECONDS),
+                goal_error(s, tolerance),
+                s.clearance.as_ref().map_or_else(|| "-".to_owned(), |c| num(c.distance * 1e3, 1)),
+                num(deg(s.limit_margin), COARSE),
+                status(s).to_owned(),
+            ],
+        );
+    }
+    table.render(&mut out);
+
+    let steps: usize = plan.segments.iter().map(|s| s.qp.steps).sum();
+    let clarabel: usize = plan.segments.iter().map(|s| s.qp.clarabel_steps).sum();
+    let share = if steps == 0 { 0.0 } else { 100.0 * clarabel as Real / steps as Real };
+    out.push_str(&format!(
+        "\ntotal  {} s of motion, {} at {} Hz, planned in {} s, Clarabel in {clarabel} of {} ({}%)\n",
+        num(plan.trajectory.duration(), SECONDS),
+        output::count(plan.trajectory.len(), "sample"),
+        short(plan.rate),
+        num(planning_time.as_secs_f64(), 2),
+        output::count(steps, "QP step"),
+        num(share, 1),
+    ));
+    out
+}
+
+/// The error of the variable furthest from its goal relative to its
+/// tolerance, as `Pw 0.42 mm` or `θsw 0.31°`; `-` for a segment without one.
+fn goal_error(s: &SegmentReport, tolerance: &Tolerance) -> String {
+    let limit = |v: Variable| if v == Variable::Pw { tolerance.position } else { tolerance.angle };
+    let worst = s
+        .errors
+        .iter()
+        .max_by(|a, b| (a.error / limit(a.variable)).total_cmp(&(b.error / limit(b.variable))));
+    match worst {
+        Some(e) if e.variable == Variable::Pw => format!("Pw {} mm", num(e.error * 1e3, 2)),
+        Some(e) => format!("{} {}°", e.variable.symbol(), num(deg(e.error), 2)),
+        None => "-".to_owned(),
+    }
+}
+
+/// `ok`, `stalled` (stopped making progress short of the goal) or `missed`
+/// (the time ran out short of it).
+fn status(s: &SegmentReport) -> &'static str {
+    match (s.reached, s.stalled) {
+        (true, _) => "ok",
+        (false, true) => "stalled",
+        (false, false) => "missed",
+    }
+}
+
+/// A number without trailing zeros: `100`, `62.5`.
+fn short(x: Real) -> String {
+    let text = num(x, 3);
+    text.trim_end_matches('0').trim_end_matches('.').to_owned()
+}
+
+/// A one-line progress bar on stderr, drawn only on a terminal and only once
+/// planning has taken longer than [`PROGRESS_DELAY`].
+struct ProgressBar {
+    started: Instant,
+    terminal: bool,
+    drawn: bool,
+}
+
+impl ProgressBar {
+    const WIDTH: usize = 24;
+
+    fn new(started: Instant) -> Self {
+        Self { started, terminal: std::io::stderr().is_terminal(), drawn: false }
+    }
+
+    fn update(&mut self, p: &Progress) {
+        if !self.terminal || self.started.elapsed() < PROGRESS_DELAY || p.total == 0 {
+            return;
+        }
+        let filled = Self::WIDTH * p.done.min(p.total) / p.total;
+        let line = format!(
+            "\r\x1b[2Kplanning [{}{}] {}/{} segments, `{}` done",
+            "#".repeat(filled),
+            "-".repeat(Self::WIDTH - filled),
+            p.done,
+            p.total,
+            p.action
+        );
+        let mut stderr = std::io::stderr().lock();
+        // A progress bar that cannot be drawn is no reason to stop planning.
+        let _ = stderr.write_all(line.as_bytes()).and_then(|()| stderr.flush());
+        self.drawn = true;
+    }
+
+    /// Erases the bar, so that what follows starts on a clean line.
+    fn clear(&mut self) {
+        if self.drawn {
+            let _ = std::io::stderr().write_all(b"\r\x1b[2K");
+            self.drawn = false;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use a2ml_core::solve::qp::QpError;
+
+    use super::*;
+
+    #[test]
+    fn rates_must_be_positive_and_finite() {
+        assert_eq!(parse_rate("250"), Ok(250.0));
+        assert!(parse_rate("0").is_err());
+        assert!(parse_rate("-5").is_err());
+        assert!(parse_rate("inf").is_err());
+        assert!(parse_rate("NaN").is_err());
+        assert!(parse_rate("fast").is_err());
+    }
+
+    #[test]
+    fn solver_failures_exit_4_and_input_errors_2() {
+        let file = Path::new("task.a2ml");
+        let failed = SolveError::Qp {
+            action: "reach".to_owned(),
+            segment: 1,
+            source: QpError::Unsolved { time: 0.25, status: "PrimalInfeasible".to_owned() },
+        };
+        let error = solve_error(file, failed);
+        assert_eq!(
+            error.to_string(),
+            "task.a2ml: action `reach`, segment 2: at t = 0.250 s the QP has no solution \
+             (Clarabel: PrimalInfeasible)"
+        );
+        assert!(matches!(error, CliError::Planning(_)));
+        let unsupported =
+            SolveError::UnsupportedSolver { action: "reach".to_owned(), solver: SolverChoice::Pmp };
+        assert!(matches!(solve_error(file, unsupported), CliError::Input(_)));
+    }
+
+    #[test]
+    fn rates_print_short() {
+        assert_eq!(short(100.0), "100");
+        assert_eq!(short(62.5), "62.5");
+    }
+
+    #[test]
+    fn default_output_is_the_stem_in_the_current_folder() {
+        let args = PlanArgs {
+            file: PathBuf::from("examples/lines.a2ml"),
+            output: None,
+            csv: None,
+            json: None,
+            solver: None,
+            rate: None,
+            seed: None,
+        };
+        assert_eq!(outputs(&args), vec![(Format::Mcap, PathBuf::from("lines.mcap"))]);
+        let args = PlanArgs { csv: Some(PathBuf::from("x.csv")), ..args };
+        assert_eq!(outputs(&args), vec![(Format::Csv, PathBuf::from("x.csv"))]);
+    }
+}
