@@ -270,3 +270,17 @@ fn obstacles_are_kept_at_the_safety_distance_when_the_path_grazes_them() {
     assert!(clearance.distance >= options.safety_distance, "{clearance:?}");
     assert_within_limits(&robot, &dense);
 }
+
+#[test]
+fn progress_is_reported_after_every_segment() {
+    let task = language::load(examples_dir().join("construct_path_about.a2ml")).expect("loads");
+    let robot = Robot::from_urdf_file(&task.robot).expect("robot");
+    let mut seen = Vec::new();
+    let plan = a2ml::solve::plan_with_progress(&robot, &task, &PlanOptions::default(), &mut |p| {
+        seen.push((p.done, p.total))
+    })
+    .expect("plans");
+    let total = plan.segments.len();
+    let expected: Vec<(usize, usize)> = (1..=total).map(|done| (done, total)).collect();
+    assert_eq!(seen, expected);
+}

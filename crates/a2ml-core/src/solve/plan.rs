@@ -97,7 +97,7 @@ pub fn plan(robot: &Robot, task: &Task, options: &PlanOptions) -> Result<Plan, S
     plan_with_progress(robot, task, options, &mut |_| {})
 }
 
-/// [`plan`], calling `progress` after each segment.
+/// [`plan`], calling `progress` after each segment is solved.
 ///
 /// # Errors
 /// As [`plan`].
@@ -125,8 +125,9 @@ pub fn plan_with_progress(
         wrist_reference: Vec::new(),
     };
     for action in &decomposition.actions {
-        state.action(action)?;
-        progress(&Progress { done: state.segments.len(), total, action: action.name.clone() });
+        state.action(action, &mut |done| {
+            progress(&Progress { done, total, action: action.name.clone() })
+        })?;
     }
     let whole = match state.whole {
         Some(w) => w.resample(rate)?,
@@ -160,7 +161,13 @@ struct Solver<'a> {
 }
 
 impl Solver<'_> {
-    fn action(&mut self, action: &PlannedAction) -> Result<(), SolveError> {
+    /// Solves and joins the action's segments, calling `solved` with the number of segments
+    /// solved in the whole plan after each.
+    fn action(
+        &mut self,
+        action: &PlannedAction,
+        solved: &mut dyn FnMut(usize),
+    ) -> Result<(), SolveError> {
         let scene = CollisionScene::new(&self.task.action_scene(action.index));
         let action_start = self.whole.as_ref().map_or(0.0, Trajectory::end);
         let mut joined: Option<Trajectory> = None;
@@ -193,6 +200,7 @@ impl Solver<'_> {
             let report =
                 self.report(action, k, segment, solver, &problem, &solution, &scene, start);
             self.segments.push(report);
+            solved(self.segments.len());
         }
         if let Some(action_trajectory) = joined {
             self.whole = Some(match self.whole.take() {
