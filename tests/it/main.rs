@@ -11,6 +11,7 @@ mod opt;
 mod output;
 mod plan;
 mod profile;
+mod push_box;
 mod robots;
 mod segments;
 mod swivel;
