@@ -38,13 +38,15 @@ pub struct VariableError {
 pub struct QpStats {
     /// Control steps taken.
     pub steps: usize,
-    /// Steps where a bound or collision row was binding and Clarabel was called.
+    /// Steps that Clarabel solved: a bound or row binds and the exact active-set step did not
+    /// settle (see [`crate::solve::qp`]).
     pub clarabel_steps: usize,
     /// Mean wall time of a step (s): Jacobian, distances and the solve.
     pub mean_step_time: Real,
     /// Longest step (s).
     pub worst_step_time: Real,
-    /// Median time of the steps that the weighted least-squares step solved (s).
+    /// Median time of the steps solved without Clarabel (s): the weighted least-squares step,
+    /// or the active-set step on it when a bound or row binds.
     pub median_fast_time: Real,
     /// Median time of the steps that needed Clarabel (s); 0 when none did.
     pub median_clarabel_time: Real,
