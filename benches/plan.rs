@@ -104,5 +104,59 @@ fn tasks(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, qp, tasks);
+/// The Panda sphere cage of ../shared/bench/panda_sphere_cage.json: the first 10 instances
+/// per iteration (divide by 10 for one).
+fn rrt(c: &mut Criterion) {
+    use a2ml::solve::rrt::{RrtOptions, rrt_connect};
+    let text = std::fs::read_to_string(path("../shared/bench/panda_sphere_cage.json"))
+        .expect("the shared benchmark file is beside");
+    let data: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let vector = |v: &serde_json::Value| -> Vec<Real> {
+        v.as_array().expect("array").iter().map(|x| x.as_f64().expect("number")).collect()
+    };
+    let start = JointVector::from_column_slice(&vector(&data["start"]));
+    let goal = JointVector::from_column_slice(&vector(&data["goal"]));
+    let radius = data["radius"].as_f64().expect("radius");
+    let scenes: Vec<CollisionScene> = (0..10)
+        .map(|k| {
+            let spheres: Vec<Obstacle> = data["instances"][k]
+                .as_array()
+                .expect("instance")
+                .iter()
+                .enumerate()
+                .map(|(i, v)| {
+                    let v = vector(v);
+                    // The file's frame is the URDF root; {b} has S 0.333 m above it.
+                    let center = Vector3::new(v[0], v[1], v[2] - 0.333);
+                    Obstacle { name: format!("s{i}"), shape: Shape::Sphere { center, radius } }
+                })
+                .collect();
+            CollisionScene::new(&spheres)
+        })
+        .collect();
+    let robot = Robot::from_urdf_file(path("robots/panda.urdf")).expect("robot");
+    let options = RrtOptions::default();
+    let mut checks = 0;
+    let started = std::time::Instant::now();
+    for scene in &scenes {
+        let found = rrt_connect(&robot, scene, &start, &[goal], &options).expect("a path");
+        checks += found.stats.collision_checks;
+    }
+    eprintln!(
+        "rrt/panda_sphere_cage: {checks} collision checks in 10 instances, {:.0} checks/s",
+        checks as Real / started.elapsed().as_secs_f64()
+    );
+    let mut group = c.benchmark_group("rrt");
+    group.sample_size(10);
+    group.bench_function("panda_sphere_cage_10_instances", |b| {
+        b.iter(|| {
+            for scene in &scenes {
+                let _ = rrt_connect(&robot, scene, &start, &[goal], black_box(&options));
+            }
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, qp, tasks, rrt);
 criterion_main!(benches);

@@ -13,5 +13,6 @@ mod plan;
 mod profile;
 mod push_box;
 mod robots;
+mod rrt;
 mod segments;
 mod swivel;

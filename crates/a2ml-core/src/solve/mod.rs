@@ -1,11 +1,13 @@
 //! Solving the segments of a decomposed task (DESIGN.md §5) and the plan they make.
 //!
 //! Entry points: [`plan`] (a task to a [`Plan`]: trajectory and one [`SegmentReport`] per
-//! segment) and [`qp::solve_segment`] (one segment with the velocity QP).
+//! segment), [`qp::solve_segment`] (one segment with the velocity QP) and
+//! [`rrt::rrt_connect`] (a collision-free joint-space path).
 
 mod plan;
 pub mod qp;
 mod report;
+pub mod rrt;
 
 pub use plan::{PlanOptions, Progress, SolveError, plan, plan_with_progress};
 pub use report::{Plan, QpStats, SegmentReport, Tolerance, VariableError};

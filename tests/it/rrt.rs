@@ -1,0 +1,117 @@
+//! Joint-space RRT-Connect: every path re-checked densely and independently (1 mm of arm-point
+//! motion between checks), limits, determinism per seed, and clear failures.
+
+use a2ml::Robot;
+use a2ml::collision::{CollisionScene, min_distance};
+use a2ml::kinematics::arm_pose;
+use a2ml::language::{Obstacle, Shape};
+use a2ml::math::{JointVector, Real, Vector3};
+use a2ml::solve::rrt::{RrtError, RrtOptions, RrtPath, rrt_connect};
+
+use crate::common;
+
+/// The Panda caged by 14 spheres (../shared/bench/panda_sphere_cage.json, instance `k`), in
+/// {b}: the file's frame is the URDF root, S is 0.333 m above it.
+fn sphere_cage(k: usize) -> (JointVector, JointVector, CollisionScene) {
+    let path = format!("{}/../shared/bench/panda_sphere_cage.json", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).expect("the shared benchmark file is beside");
+    let data: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let vector = |v: &serde_json::Value| -> Vec<Real> {
+        v.as_array().expect("array").iter().map(|x| x.as_f64().expect("number")).collect()
+    };
+    let q = |key: &str| JointVector::from_column_slice(&vector(&data[key]));
+    let radius = data["radius"].as_f64().expect("radius");
+    let obstacles: Vec<Obstacle> = data["instances"][k]
+        .as_array()
+        .expect("instance")
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let c = vector(c);
+            Obstacle {
+                name: format!("sphere{i}"),
+                shape: Shape::Sphere { center: Vector3::new(c[0], c[1], c[2] - 0.333), radius },
+            }
+        })
+        .collect();
+    (q("start"), q("goal"), CollisionScene::new(&obstacles))
+}
+
+/// Every edge at points no more than 1 mm of arm motion apart (bounded by 1.5 m of lever per
+/// radian, more than any shipped arm's reach): within limits and `clearance` from the scene.
+fn assert_collision_free(robot: &Robot, scene: &CollisionScene, path: &RrtPath, clearance: Real) {
+    for w in path.waypoints.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let count = ((b - a).abs().sum() * 1.5 / 1e-3).ceil().max(1.0) as usize;
+        for k in 0..=count {
+            let q = a + (b - a) * (k as Real / count as Real);
+            assert!(robot.limit_violation(&q, 0.0).is_none(), "outside the limits");
+            if let Some((d, link, obstacle)) = min_distance(robot, &arm_pose(robot, &q), scene) {
+                assert!(d >= clearance, "{link} {d:.4} m from {obstacle}");
+            }
+        }
+    }
+}
+
+#[test]
+fn the_caged_panda_finds_a_collision_free_path() {
+    let robot = common::load("panda");
+    let options = RrtOptions::default();
+    for k in [0, 1, 2] {
+        let (start, goal, scene) = sphere_cage(k);
+        let path = rrt_connect(&robot, &scene, &start, &[goal], &options).expect("a path");
+        assert_eq!(path.waypoints.first(), Some(&start));
+        assert_eq!(path.waypoints.last(), Some(&goal));
+        assert_collision_free(&robot, &scene, &path, options.clearance);
+        assert!(path.stats.collision_checks > 0 && path.stats.nodes >= 2);
+    }
+}
+
+#[test]
+fn the_same_seed_gives_the_same_path() {
+    let robot = common::load("panda");
+    let (start, goal, scene) = sphere_cage(3);
+    let options = RrtOptions { seed: 7, ..RrtOptions::default() };
+    let a = rrt_connect(&robot, &scene, &start, &[goal], &options).expect("a path");
+    let b = rrt_connect(&robot, &scene, &start, &[goal], &options).expect("a path");
+    assert_eq!(a.waypoints, b.waypoints);
+    let other = RrtOptions { seed: 8, ..options };
+    let c = rrt_connect(&robot, &scene, &start, &[goal], &other).expect("a path");
+    assert_collision_free(&robot, &scene, &c, options.clearance);
+}
+
+#[test]
+fn invalid_ends_and_exhausted_searches_are_reported() {
+    let robot = common::load("panda");
+    let (start, goal, scene) = sphere_cage(0);
+    let options = RrtOptions::default();
+    // A goal outside the limits, and a start inside an obstacle.
+    let mut outside = goal;
+    outside[3] = 1.0;
+    assert!(matches!(
+        rrt_connect(&robot, &scene, &start, &[outside], &options),
+        Err(RrtError::NoValidGoal { count: 1 })
+    ));
+    let wrist = arm_pose(&robot, &start).wrist;
+    let block = CollisionScene::new(&[Obstacle {
+        name: "block".into(),
+        shape: Shape::Sphere { center: wrist, radius: 0.05 },
+    }]);
+    let message = rrt_connect(&robot, &block, &start, &[goal], &options)
+        .expect_err("the start is in the block")
+        .to_string();
+    assert!(message.contains("from `block`"), "{message}");
+    // Too few samples for the cage.
+    let few = RrtOptions { max_samples: 1, ..options };
+    match rrt_connect(&robot, &scene, &start, &[goal], &few) {
+        Err(RrtError::NoPath { stats, closest }) => {
+            assert_eq!(stats.samples, 1);
+            assert!(closest > 0.0);
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(matches!(
+        rrt_connect(&robot, &scene, &start, &[goal], &RrtOptions { step: 0.0, ..options }),
+        Err(RrtError::InvalidOptions { .. })
+    ));
+}
