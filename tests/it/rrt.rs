@@ -6,7 +6,7 @@ use a2ml::collision::{CollisionScene, min_distance};
 use a2ml::kinematics::arm_pose;
 use a2ml::language::{Obstacle, Shape};
 use a2ml::math::{JointVector, Real, Vector3};
-use a2ml::solve::rrt::{RrtError, RrtOptions, RrtPath, rrt_connect};
+use a2ml::solve::rrt::{RrtError, RrtOptions, RrtPath, rrt_connect, time_parameterise};
 
 use crate::common;
 
@@ -114,4 +114,35 @@ fn invalid_ends_and_exhausted_searches_are_reported() {
         rrt_connect(&robot, &scene, &start, &[goal], &RrtOptions { step: 0.0, ..options }),
         Err(RrtError::InvalidOptions { .. })
     ));
+}
+
+#[test]
+fn a_path_is_timed_with_a_bell_within_the_speed_limits() {
+    let robot = common::load("panda");
+    let (start, goal, scene) = sphere_cage(0);
+    let path = rrt_connect(&robot, &scene, &start, &[goal], &RrtOptions::default()).expect("path");
+    // Asked for far too fast: stretched until the fastest joint just meets its limit.
+    let timed = time_parameterise(&robot, &path.waypoints, 0.1, 100.0).expect("timed");
+    assert!(timed.stretched && timed.duration > 0.1);
+    let t = &timed.trajectory;
+    assert!((t.positions()[0] - start).amax() < 1e-12);
+    assert!((t.positions().last().expect("samples") - goal).amax() < 1e-9);
+    assert!(
+        t.velocities()[0].amax() < 1e-12 && t.velocities().last().expect("samples").amax() < 1e-9
+    );
+    let violations = a2ml::trajectory::check_limits(t, &robot, 1e-9);
+    assert!(violations.is_empty(), "{:?}", violations.first());
+    let fastest = t
+        .velocities()
+        .iter()
+        .map(|v| v.component_div(&robot.velocity_limits()).amax())
+        .fold(0.0, Real::max);
+    assert!(fastest > 0.95, "the stretch is no longer than needed: {fastest}");
+    // Asked for slowly enough: kept.
+    let slow =
+        time_parameterise(&robot, &path.waypoints, 3.0 * timed.duration, 100.0).expect("timed");
+    assert!(!slow.stretched && (slow.duration - 3.0 * timed.duration).abs() < 1e-12);
+    // Every sample lies on the path: within the timed trajectory, a dense re-check holds too.
+    let dense = RrtPath { waypoints: slow.trajectory.positions().to_vec(), ..path };
+    assert_collision_free(&robot, &scene, &dense, RrtOptions::default().clearance - 1e-9);
 }

@@ -16,7 +16,9 @@ use rand::{RngExt, SeedableRng};
 use crate::collision::{CollisionScene, min_distance};
 use crate::kinematics::arm_pose;
 use crate::math::{JointVector, Real};
+use crate::profile::{BellProfile, JointSample};
 use crate::robot::Robot;
+use crate::trajectory::{Trajectory, TrajectoryError};
 
 /// Settings of [`rrt_connect`].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -389,6 +391,70 @@ fn shortcut(
         }
     }
     path
+}
+
+/// A path timed with the bell profile (paper eq. 9) along its joint-space arc length.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimedPath {
+    /// Samples at the rate asked for, plus the end.
+    pub trajectory: Trajectory,
+    /// The duration used (s).
+    pub duration: Real,
+    /// Whether the duration asked for was stretched to keep every joint within its speed
+    /// limit.
+    pub stretched: bool,
+}
+
+/// Times `waypoints` with a bell-shaped speed along the path's arc length s: ṡ peaks at 2L/T
+/// mid-way and is zero at both ends. Joint i moves at u_i ṡ on an edge of unit direction u,
+/// so T is stretched to 2L max |u_i| / v_i when `duration` would exceed a speed limit.
+///
+/// # Errors
+/// [`TrajectoryError`] for fewer than one waypoint, a non-positive rate or duration, or
+/// non-finite values.
+pub fn time_parameterise(
+    robot: &Robot,
+    waypoints: &[JointVector],
+    duration: Real,
+    rate: Real,
+) -> Result<TimedPath, TrajectoryError> {
+    let first = *waypoints.first().ok_or(TrajectoryError::Empty)?;
+    if !(rate.is_finite() && rate > 0.0) {
+        return Err(TrajectoryError::InvalidRate { rate_hz: rate });
+    }
+    let edges: Vec<(JointVector, Real)> = waypoints
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| d.norm() > 0.0)
+        .map(|d| (d / d.norm(), d.norm()))
+        .collect();
+    let length: Real = edges.iter().map(|(_, l)| l).sum();
+    let speed = robot.velocity_limits();
+    let needed = edges
+        .iter()
+        .flat_map(|(u, _)| (0..u.len()).map(move |i| 2.0 * length * u[i].abs() / speed[i]))
+        .fold(0.0, Real::max);
+    let stretched = needed > duration;
+    let duration = duration.max(needed);
+    let bell = BellProfile::new(duration, length).map_err(TrajectoryError::Join)?;
+    let at = |t: Real| -> JointSample {
+        let (mut s, rate) = (bell.progress(t), bell.speed(t));
+        let mut q = first;
+        for (u, l) in &edges {
+            if s <= *l {
+                return (q + u * s, u * rate);
+            }
+            q += u * *l;
+            s -= l;
+        }
+        (q, JointVector::zeros())
+    };
+    let count = (duration * rate).floor() as usize;
+    let mut times: Vec<Real> = (0..=count).map(|k| k as Real / rate).collect();
+    times.retain(|&t| t < duration - 1e-9 / rate);
+    times.push(duration);
+    let trajectory = Trajectory::from_fn(times, at)?;
+    Ok(TimedPath { trajectory, duration, stretched })
 }
 
 /// The length of a joint-space path (rad, Euclidean per edge).
