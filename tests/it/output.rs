@@ -23,7 +23,7 @@ const RATE: Real = 250.0;
 /// Number of samples: 0.4 s at [`RATE`].
 const SAMPLES: usize = 101;
 /// Fields that may be null although their schema gives another type (see `schemas.rs`).
-const NULLABLE: [&str; 4] = ["cpsa", "hat", "action_type", "clearance"];
+const NULLABLE: [&str; 5] = ["cpsa", "hat", "action_type", "clearance", "rrt"];
 
 fn example(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples").join(name)
@@ -73,6 +73,7 @@ fn report(action: &str, index: usize, start: Real, end: Real) -> SegmentReport {
         stalled: false,
         reached: true,
         qp: QpStats { steps: 40, ..QpStats::default() },
+        rrt: None,
     }
 }
 

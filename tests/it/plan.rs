@@ -284,3 +284,50 @@ fn progress_is_reported_after_every_segment() {
     let expected: Vec<(usize, usize)> = (1..=total).map(|done| (done, total)).collect();
     assert_eq!(seen, expected);
 }
+
+#[test]
+fn auto_gives_a_goal_among_obstacles_to_the_rrt_which_reaches_it_clear() {
+    // The QP stalls on this one (see the stall test's twin, construct_scene): auto plans it
+    // with the RRT instead.
+    let task = language::load(examples_dir().join("construct_scene.a2ml")).expect("loads");
+    let robot = Robot::from_urdf_file(&task.robot).expect("robot");
+    let planned = plan(&robot, &task, &PlanOptions::default()).expect("plans");
+    let report = &planned.segments[0];
+    assert_eq!(report.solver, language::SolverChoice::Rrt);
+    assert!(report.rrt.is_some_and(|s| s.nodes >= 2 && s.collision_checks > 0));
+    assert!(planned.reached(), "{:?}", planned.warnings);
+    assert_within_limits(&robot, &planned.trajectory);
+    // Clear of every obstacle at 1 kHz, by an independent check.
+    let scene = CollisionScene::new(&task.scene);
+    let dense = planned.trajectory.resample(1000.0).expect("resamples");
+    let clearance = trajectory::min_clearance(&dense, &robot, &scene).expect("pairs");
+    assert!(clearance.distance >= planned.safety_distance - 1e-6, "{clearance:?}");
+    // The goal, re-measured by FK at the end.
+    let end = planned.trajectory.positions().last().expect("samples");
+    let state = a2ml::decompose::ArmState::at(&robot, end).expect("regular");
+    let language::ActionBody::Constraints { goal: Some(goal), .. } = &task.actions[0].body else {
+        panic!("a goal action")
+    };
+    let error = a2ml::decompose::goal_error(&state, &goal.primary.targets);
+    assert!(error < 1e-3, "{error}");
+    // The same seed plans the same motion; the QP alone stalls.
+    let again = plan(&robot, &task, &PlanOptions::default()).expect("plans");
+    assert_eq!(again.trajectory, planned.trajectory);
+    let qp_only =
+        PlanOptions { solver: Some(language::SolverChoice::Qp), ..PlanOptions::default() };
+    assert!(!plan_reached(&robot, &task, &qp_only));
+}
+
+fn plan_reached(robot: &Robot, task: &Task, options: &PlanOptions) -> bool {
+    plan(robot, task, options).expect("plans").reached()
+}
+
+#[test]
+fn the_rrt_does_not_yet_plan_segments_with_paths() {
+    let task = language::load(examples_dir().join("construct_path_line.a2ml")).expect("loads");
+    let robot = Robot::from_urdf_file(&task.robot).expect("robot");
+    let options =
+        PlanOptions { solver: Some(language::SolverChoice::Rrt), ..PlanOptions::default() };
+    let message = plan(&robot, &task, &options).expect_err("a path segment").to_string();
+    assert!(message.contains("rrt plans goal segments"), "{message}");
+}

@@ -155,7 +155,7 @@ def test_segment_reports(plan: Plan) -> None:
         assert set(s.path_errors) <= set(expected)
         assert s.clearance is None or isinstance(s.clearance, a2ml.Clearance)
         assert not s.stalled and s.reached
-        assert isinstance(s.qp, a2ml.QpStats)
+        assert isinstance(s.qp, a2ml.QpStats) and s.rrt is None
         assert s.qp.steps > 0 and 0 <= s.qp.clarabel_steps <= s.qp.steps
         assert s.qp.worst_step_time >= s.qp.mean_step_time > 0.0
         d = s.to_dict()
@@ -420,3 +420,14 @@ def test_mcap_of_a_parsed_task_attaches_its_text(tmp_path: Path) -> None:
     recording = Recording(path)
     assert recording.attachments["lines.a2ml"].data == text.encode("utf-8")
     assert len(recording.messages["/joint_states"]) == len(p.t)
+
+
+def test_auto_gives_a_goal_among_obstacles_to_the_rrt() -> None:
+    plan = a2ml.plan(EXAMPLES / "construct_scene.a2ml")
+    (report,) = plan.segments
+    assert report.solver == "rrt" and plan.reached
+    assert isinstance(report.rrt, a2ml.RrtStats)
+    assert report.rrt.nodes >= 2 and report.rrt.collision_checks > 0
+    assert report.to_dict()["rrt"] == report.rrt
+    again = pickle.loads(pickle.dumps(report))
+    assert again == report and again.rrt == report.rrt

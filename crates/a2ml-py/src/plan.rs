@@ -14,6 +14,7 @@ use a2ml_core::decompose::{ActionType, SegmentPattern};
 use a2ml_core::language::SolverChoice;
 use a2ml_core::math::{DOF, JointVector, Real, Vector3};
 use a2ml_core::output;
+use a2ml_core::solve::rrt::RrtStats;
 use a2ml_core::solve::{self, Plan, PlanOptions, QpStats, SegmentReport, VariableError};
 use a2ml_core::trajectory::{Clearance, Trajectory};
 use numpy::IntoPyArray;
@@ -429,6 +430,16 @@ impl PySegmentReport {
         record(py, "QpStats", fields)
     }
 
+    /// RRT counters when the RRT solved the segment.
+    #[getter]
+    fn rrt<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.report
+            .rrt
+            .as_ref()
+            .map(|s| record(py, "RrtStats", (s.samples, s.nodes, s.collision_checks, s.time)))
+            .transpose()
+    }
+
     /// Every field as one dict.
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Dict<'py>> {
         let d = PyDict::new(py);
@@ -451,6 +462,7 @@ impl PySegmentReport {
         d.set_item("stalled", self.stalled())?;
         d.set_item("reached", self.reached())?;
         d.set_item("qp", self.qp(py)?)?;
+        d.set_item("rrt", self.rrt(py)?)?;
         Ok(d)
     }
 
@@ -471,6 +483,7 @@ impl PySegmentReport {
         let focus: Vec<String> = item(d, "focus")?.extract()?;
         let clearance: Option<(Real, Real, String, String)> = item(d, "clearance")?.extract()?;
         let qp: (usize, usize, Real, Real, Real, Real) = item(d, "qp")?.extract()?;
+        let rrt: Option<(usize, usize, usize, Real)> = item(d, "rrt")?.extract()?;
         let report = SegmentReport {
             action: item(d, "action")?.extract()?,
             action_index: item(d, "action_index")?.extract()?,
@@ -503,6 +516,12 @@ impl PySegmentReport {
                 median_fast_time: qp.4,
                 median_clarabel_time: qp.5,
             },
+            rrt: rrt.map(|(samples, nodes, collision_checks, time)| RrtStats {
+                samples,
+                nodes,
+                collision_checks,
+                time,
+            }),
         };
         Ok(Self { report })
     }

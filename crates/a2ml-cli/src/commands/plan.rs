@@ -199,9 +199,10 @@ fn solve_error(file: &Path, error: SolveError) -> CliError {
         SolveError::Decompose(_)
         | SolveError::InvalidRate { .. }
         | SolveError::UnsupportedSolver { .. } => CliError::Input(message),
-        SolveError::Reference { .. } | SolveError::Qp { .. } | SolveError::Trajectory(_) => {
-            CliError::Planning(message)
-        }
+        SolveError::Reference { .. }
+        | SolveError::Qp { .. }
+        | SolveError::Rrt { .. }
+        | SolveError::Trajectory(_) => CliError::Planning(message),
     }
 }
 
@@ -345,6 +346,7 @@ impl ProgressBar {
 
 #[cfg(test)]
 mod tests {
+    use a2ml_core::decompose::SegmentPattern;
     use a2ml_core::solve::qp::QpError;
 
     use super::*;
@@ -374,8 +376,11 @@ mod tests {
              (Clarabel: PrimalInfeasible)"
         );
         assert!(matches!(error, CliError::Planning(_)));
-        let unsupported =
-            SolveError::UnsupportedSolver { action: "reach".to_owned(), solver: SolverChoice::Pmp };
+        let unsupported = SolveError::UnsupportedSolver {
+            action: "reach".to_owned(),
+            solver: SolverChoice::Pmp,
+            pattern: SegmentPattern::Goal,
+        };
         assert!(matches!(solve_error(file, unsupported), CliError::Input(_)));
     }
 

@@ -364,6 +364,12 @@ pub(super) fn segment() -> Schema {
             "median_clarabel_time",
         ],
     );
+    let mut rrt = object(
+        None,
+        json!({ "samples": i, "nodes": i, "collision_checks": i, "time": described("number", "s") }),
+        &["samples", "nodes", "collision_checks", "time"],
+    );
+    rrt["description"] = json!("RRT counters when the RRT solved the segment; null otherwise");
     let fields = json!({
         "timestamp": time(),
         "action": s,
@@ -385,6 +391,7 @@ pub(super) fn segment() -> Schema {
         "stalled": b,
         "reached": b,
         "qp": qp,
+        "rrt": rrt,
     });
     let required: Vec<&str> =
         fields.as_object().map(|m| m.keys().map(String::as_str).collect()).unwrap_or_default();

@@ -1,13 +1,15 @@
 //! A whole task: decompose, solve every segment from where the last one really ended, join
 //! segments (+Tr within an action, +Se between actions) and report on each.
 
-use super::qp::{self, Component, QpError, QpOptions, QpSolution, SegmentProblem};
-use super::report::{Plan, SegmentReport, VariableError};
+use super::qp::{self, Component, QpError, QpOptions, SegmentProblem};
+use super::report::{Plan, QpStats, SegmentReport, VariableError};
+use super::rrt::{RrtError, RrtOptions, RrtStats, rrt_connect, time_parameterise};
 use crate::collision::CollisionScene;
 use crate::decompose::{
-    ArmState, DecomposeError, DecomposeOptions, PlannedAction, PlannedSegment, decompose,
+    ArmState, DecomposeError, DecomposeOptions, PlannedAction, PlannedSegment, SegmentPattern,
+    decompose, goal_error,
 };
-use crate::kinematics::{HatState, hat_to_cpsa};
+use crate::kinematics::{HatState, hat_to_cpsa, ik_cpsa};
 use crate::language::{PrimitiveConstraint, SolverChoice, Space, Task, Variable};
 use crate::math::{DOF, JointVector, Real, Vector3};
 use crate::profile::{BodyFrames, ProfileError, Reference, Role, Sample};
@@ -21,6 +23,8 @@ pub struct PlanOptions {
     pub decompose: DecomposeOptions,
     /// The velocity QP.
     pub qp: QpOptions,
+    /// RRT-Connect (its seed and clearance come from the task and `qp.safety_distance`).
+    pub rrt: RrtOptions,
     /// Solver for every segment, overriding the task and its actions.
     pub solver: Option<SolverChoice>,
     /// Output rate (Hz), overriding the task's `settings { rate }`.
@@ -50,16 +54,31 @@ pub enum SolveError {
         /// The rate asked for (Hz).
         rate: Real,
     },
-    /// The solver asked for does not exist yet.
+    /// The solver asked for does not exist yet for this kind of segment.
     #[error(
-        "action `{action}`: solver `{}` is not available yet; use `qp` or `auto`",
-        solver.name()
+        "action `{action}`: solver `{}` is not available yet for pattern-{} segments; use `qp` \
+         or `auto`{}",
+        solver.name(),
+        pattern.number(),
+        if *solver == SolverChoice::Rrt { " (rrt plans goal segments, pattern 2, so far)" } else { "" }
     )]
     UnsupportedSolver {
         /// The action.
         action: String,
         /// The solver asked for.
         solver: SolverChoice,
+        /// The segment's pattern.
+        pattern: SegmentPattern,
+    },
+    /// The RRT found no path (asked for explicitly; `auto` falls back to the QP).
+    #[error("action `{action}`, segment {}: rrt: {source}", segment + 1)]
+    Rrt {
+        /// The action.
+        action: String,
+        /// Segment index (0-based).
+        segment: usize,
+        /// Why.
+        source: RrtError,
     },
     /// A segment's references cannot be built.
     #[error("action `{action}`, segment {}: {source}", segment + 1)]
@@ -123,6 +142,7 @@ pub fn plan_with_progress(
         whole: None,
         segments: Vec::with_capacity(total),
         wrist_reference: Vec::new(),
+        notes: Vec::new(),
     };
     for action in &decomposition.actions {
         state.action(action, &mut |done| {
@@ -134,7 +154,8 @@ pub fn plan_with_progress(
         // No action: the arm stays at the start.
         None => Trajectory::new(vec![0.0], vec![decomposition.start], vec![JointVector::zeros()])?,
     };
-    let warnings = state.segments.iter().filter(|s| !s.reached).map(missed).collect();
+    let mut warnings = state.notes;
+    warnings.extend(state.segments.iter().filter(|s| !s.reached).map(missed));
     Ok(Plan {
         task: decomposition.task,
         joint_names: robot.joint_names().iter().map(|n| (*n).to_owned()).collect(),
@@ -158,6 +179,8 @@ struct Solver<'a> {
     whole: Option<Trajectory>,
     segments: Vec<SegmentReport>,
     wrist_reference: Vec<(Real, Vector3)>,
+    /// Warnings other than missed goals: fallbacks and stretched durations.
+    notes: Vec<String>,
 }
 
 impl Solver<'_> {
@@ -173,15 +196,8 @@ impl Solver<'_> {
         let mut joined: Option<Trajectory> = None;
         let mut last: Option<(Real, Real)> = None; // (start, duration) of the previous segment
         for (k, segment) in action.segments.iter().enumerate() {
-            let solver = self.solver(action, segment)?;
             let problem = self.problem(action, k, segment)?;
-            let solution =
-                qp::solve_segment(self.robot, &scene, &problem, &self.q, &self.options.qp)
-                    .map_err(|source| SolveError::Qp {
-                        action: action.name.clone(),
-                        segment: k,
-                        source,
-                    })?;
+            let solution = self.solve(action, k, segment, &problem, &scene)?;
             let duration = solution.trajectory.duration();
             let (start, next) = match (joined.take(), last) {
                 (Some(before), Some((prev_start, prev_duration))) => {
@@ -197,8 +213,7 @@ impl Solver<'_> {
                 self.q = *end;
             }
             self.reference(&problem, start);
-            let report =
-                self.report(action, k, segment, solver, &problem, &solution, &scene, start);
+            let report = self.report(action, k, segment, &problem, &solution, &scene, start);
             self.segments.push(report);
             solved(self.segments.len());
         }
@@ -211,17 +226,122 @@ impl Solver<'_> {
         Ok(())
     }
 
-    /// The solver a segment runs with: the override, else its own choice; `auto` is the QP
-    /// until the sampling solver exists.
-    fn solver(
+    /// Solves one segment with its solver: the override, else its own choice. `auto`
+    /// (DESIGN.md §5) gives a goal segment among obstacles to the RRT, falling back to the QP
+    /// with a warning when the RRT finds no path, and every other segment to the QP.
+    fn solve(
+        &mut self,
+        action: &PlannedAction,
+        k: usize,
+        segment: &PlannedSegment,
+        problem: &SegmentProblem,
+        scene: &CollisionScene,
+    ) -> Result<Solved, SolveError> {
+        let goal = segment.pattern == SegmentPattern::Goal;
+        match self.options.solver.unwrap_or(segment.solver) {
+            SolverChoice::Qp => self.qp(action, k, problem, scene),
+            SolverChoice::Auto if goal && !scene.is_empty() => {
+                match self.rrt(action, k, segment, problem, scene) {
+                    Ok(solved) => Ok(solved),
+                    Err(SolveError::Rrt { source, .. }) => {
+                        self.notes.push(format!(
+                            "action `{}`, segment {}: rrt: {source}; the QP's result is kept",
+                            action.name,
+                            k + 1
+                        ));
+                        self.qp(action, k, problem, scene)
+                    }
+                    Err(e) => Err(e),
+                }
+            }
+            SolverChoice::Auto => self.qp(action, k, problem, scene),
+            SolverChoice::Rrt if goal => self.rrt(action, k, segment, problem, scene),
+            solver => Err(SolveError::UnsupportedSolver {
+                action: action.name.clone(),
+                solver,
+                pattern: segment.pattern,
+            }),
+        }
+    }
+
+    fn qp(
         &self,
         action: &PlannedAction,
+        k: usize,
+        problem: &SegmentProblem,
+        scene: &CollisionScene,
+    ) -> Result<Solved, SolveError> {
+        let solution = qp::solve_segment(self.robot, scene, problem, &self.q, &self.options.qp)
+            .map_err(|source| SolveError::Qp { action: action.name.clone(), segment: k, source })?;
+        Ok(Solved {
+            solver: SolverChoice::Qp,
+            trajectory: solution.trajectory,
+            errors: solution.errors,
+            max_errors: solution.max_errors,
+            settle: solution.settle,
+            reached: solution.reached,
+            stalled: solution.stalled,
+            qp: solution.stats,
+            rrt: None,
+        })
+    }
+
+    /// A goal segment by RRT-Connect in joint space towards the IK branches of its end state
+    /// (the decomposition's configuration first), timed with the bell profile.
+    fn rrt(
+        &mut self,
+        action: &PlannedAction,
+        k: usize,
         segment: &PlannedSegment,
-    ) -> Result<SolverChoice, SolveError> {
-        match self.options.solver.unwrap_or(segment.solver) {
-            SolverChoice::Auto | SolverChoice::Qp => Ok(SolverChoice::Qp),
-            solver => Err(SolveError::UnsupportedSolver { action: action.name.clone(), solver }),
+        problem: &SegmentProblem,
+        scene: &CollisionScene,
+    ) -> Result<Solved, SolveError> {
+        let mut goals = vec![segment.end];
+        if let Ok(state) = ArmState::at(self.robot, &segment.end) {
+            if let Ok(branches) = ik_cpsa(self.robot, &state.cpsa, Some(&segment.end)) {
+                goals.extend(branches.into_iter().filter(|q| (q - segment.end).amax() > 1e-9));
+            }
         }
+        let options = RrtOptions {
+            seed: self.task.settings.seed,
+            clearance: self.options.qp.safety_distance,
+            ..self.options.rrt
+        };
+        let failed = |source| SolveError::Rrt { action: action.name.clone(), segment: k, source };
+        let path = rrt_connect(self.robot, scene, &self.q, &goals, &options).map_err(failed)?;
+        let timed = time_parameterise(
+            self.robot,
+            &path.waypoints,
+            segment.duration,
+            1.0 / self.options.qp.step,
+        )?;
+        if timed.stretched {
+            self.notes.push(format!(
+                "action `{}`, segment {}: the rrt path takes {:.2} s instead of {:.2} s to keep \
+                 every joint within its speed limit",
+                action.name,
+                k + 1,
+                timed.duration,
+                segment.duration
+            ));
+        }
+        let end = timed.trajectory.positions().last().copied().unwrap_or(self.q);
+        let errors = end_errors(self.robot, problem, &end);
+        let tolerance = &self.options.qp.tolerance;
+        let reached = problem.components.iter().zip(errors).all(|(c, e)| {
+            e <= if c.variable == Variable::Pw { tolerance.position } else { tolerance.angle }
+        });
+        Ok(Solved {
+            solver: SolverChoice::Rrt,
+            trajectory: timed.trajectory,
+            errors,
+            max_errors: errors,
+            settle: 0.0,
+            reached,
+            stalled: false,
+            qp: QpStats::default(),
+            rrt: Some(path.stats),
+        })
     }
 
     /// The segment's references, starting from where the arm really is.
@@ -292,9 +412,8 @@ impl Solver<'_> {
         action: &PlannedAction,
         k: usize,
         segment: &PlannedSegment,
-        solver: SolverChoice,
         problem: &SegmentProblem,
-        solution: &QpSolution,
+        solution: &Solved,
         scene: &CollisionScene,
         start: Real,
     ) -> SegmentReport {
@@ -317,7 +436,7 @@ impl Solver<'_> {
             action_type: action.classification.as_ref().map(|c| c.action_type),
             space: segment.space,
             pattern: segment.pattern,
-            solver,
+            solver: solution.solver,
             focus: segment.primitives.first().map(|p| p.variables.clone()).unwrap_or_default(),
             start,
             end: start + solution.trajectory.duration(),
@@ -329,9 +448,31 @@ impl Solver<'_> {
             limit_margin: limit_margin(self.robot, &solution.trajectory),
             stalled: solution.stalled,
             reached: solution.reached,
-            qp: solution.stats,
+            qp: solution.qp,
+            rrt: solution.rrt,
         }
     }
+}
+
+/// A segment as one of the solvers solved it.
+struct Solved {
+    solver: SolverChoice,
+    /// From time 0.
+    trajectory: Trajectory,
+    errors: [Real; 3],
+    max_errors: [Real; 3],
+    settle: Real,
+    reached: bool,
+    stalled: bool,
+    qp: QpStats,
+    rrt: Option<RrtStats>,
+}
+
+/// Each component's error at configuration `q` against its reference's end: distance for
+/// Pw, geodesic angle for rotations, (wrapped) angle difference.
+fn end_errors(robot: &Robot, problem: &SegmentProblem, q: &JointVector) -> [Real; 3] {
+    let Ok(state) = ArmState::at(robot, q) else { return [Real::INFINITY; 3] };
+    problem.components.map(|c| goal_error(&state, &[(c.variable, c.reference.end())]))
 }
 
 /// The trajectory with `offset` added to its times.

@@ -92,8 +92,10 @@ pub struct SegmentReport {
     pub stalled: bool,
     /// Whether every variable is within the tolerance at the end.
     pub reached: bool,
-    /// QP counters and timings.
+    /// QP counters and timings (zero when another solver ran).
     pub qp: QpStats,
+    /// RRT counters, when the RRT solved the segment.
+    pub rrt: Option<crate::solve::rrt::RrtStats>,
 }
 
 /// A planned task: the whole joint trajectory at the output rate and what each segment did.

@@ -21,7 +21,7 @@ Invalid task text raises :class:`ParseError`, located by ``line`` and
 decomposed raises :class:`DecomposeError`, one that cannot be solved
 :class:`PlanError`. :class:`Decomposition` and the other ``TypedDict``
 classes describe what :func:`decompose` returns; :class:`VariableError`,
-:class:`Clearance` and :class:`QpStats` are the records of a
+:class:`Clearance`, :class:`QpStats` and :class:`RrtStats` are the records of a
 :class:`SegmentReport`.
 """
 
@@ -52,6 +52,7 @@ from a2ml._types import (
     PlannedAction,
     PlannedSegment,
     QpStats,
+    RrtStats,
     VariableError,
 )
 
@@ -70,6 +71,7 @@ __all__ = [
     "PlannedSegment",
     "QpStats",
     "Robot",
+    "RrtStats",
     "SegmentReport",
     "SingularityError",
     "Task",

@@ -24,7 +24,7 @@ from typing import Any, ClassVar, Literal, final
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from a2ml._types import Clearance, Decomposition, QpStats, VariableError
+from a2ml._types import Clearance, Decomposition, QpStats, RrtStats, VariableError
 
 __all__ = [
     "__version__",
@@ -499,6 +499,10 @@ class SegmentReport:
     @property
     def qp(self) -> QpStats:
         """The velocity QP's counters and timings over the segment."""
+
+    @property
+    def rrt(self) -> RrtStats | None:
+        """The RRT's counters when the RRT solved the segment, else None."""
 
     def to_dict(self) -> dict[str, Any]:
         """Every field above in one dict (records as their NamedTuples), e.g.

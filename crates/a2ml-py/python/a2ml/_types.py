@@ -22,6 +22,7 @@ __all__ = [
     "PlannedAction",
     "PlannedSegment",
     "QpStats",
+    "RrtStats",
     "VariableError",
 ]
 
@@ -120,6 +121,17 @@ class Clearance(NamedTuple):
     time: float
     link: str
     obstacle: str
+
+
+class RrtStats(NamedTuple):
+    """Counters of the RRT over a segment it solved: random ``samples``
+    drawn, ``nodes`` in both trees, configurations checked for
+    ``collision_checks``, and the wall ``time`` (s)."""
+
+    samples: int
+    nodes: int
+    collision_checks: int
+    time: float
 
 
 class QpStats(NamedTuple):
