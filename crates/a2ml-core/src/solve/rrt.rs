@@ -258,10 +258,6 @@ impl<'a> Space<'a> {
         }
     }
 
-    fn free(&mut self, q: &JointVector) -> bool {
-        self.clearance_at(q) >= self.options.clearance + self.options.resolution
-    }
-
     /// The smallest distance of the arm at `q` from the scene and from itself (∞ with no
     /// pair).
     fn clearance_at(&mut self, q: &JointVector) -> Real {
