@@ -273,7 +273,7 @@ fn summary(
 /// The error of the variable furthest from its goal relative to its
 /// tolerance, as `Pw 0.42 mm` or `θsw 0.31°`; `-` for a segment without one.
 fn goal_error(s: &SegmentReport, tolerance: &Tolerance) -> String {
-    let limit = |v: Variable| if v == Variable::Pw { tolerance.position } else { tolerance.angle };
+    let limit = |v: Variable| tolerance.of(v);
     let worst = s
         .errors
         .iter()

@@ -486,23 +486,14 @@ impl<'a> Controller<'a> {
 
     fn within(&self, errors: &[Real; 3]) -> bool {
         let tol = &self.options.tolerance;
-        self.problem
-            .components
-            .iter()
-            .zip(errors)
-            .all(|(c, e)| *e <= if c.variable == Variable::Pw { tol.position } else { tol.angle })
+        self.problem.components.iter().zip(errors).all(|(c, e)| *e <= tol.of(c.variable))
     }
 
     /// The errors in units of their tolerances, summed: one number that falls as the arm
     /// approaches the goal.
     fn score(&self, errors: &[Real; 3]) -> Real {
         let tol = &self.options.tolerance;
-        self.problem
-            .components
-            .iter()
-            .zip(errors)
-            .map(|(c, e)| e / if c.variable == Variable::Pw { tol.position } else { tol.angle })
-            .sum()
+        self.problem.components.iter().zip(errors).map(|(c, e)| e / tol.of(c.variable)).sum()
     }
 }
 

@@ -15,6 +15,14 @@ pub struct Tolerance {
     pub angle: Real,
 }
 
+impl Tolerance {
+    /// The tolerance of `variable`: [`Self::position`] for Pw (m), [`Self::angle`] for the
+    /// rotations and angles (rad).
+    pub fn of(&self, variable: Variable) -> Real {
+        if variable == Variable::Pw { self.position } else { self.angle }
+    }
+}
+
 impl Default for Tolerance {
     fn default() -> Self {
         Self { position: 1e-3, angle: 1.0_f64.to_radians() }
