@@ -328,9 +328,8 @@ impl Solver<'_> {
         let end = timed.trajectory.positions().last().copied().unwrap_or(self.q);
         let errors = end_errors(self.robot, problem, &end);
         let tolerance = &self.options.qp.tolerance;
-        let reached = problem.components.iter().zip(errors).all(|(c, e)| {
-            e <= if c.variable == Variable::Pw { tolerance.position } else { tolerance.angle }
-        });
+        let reached =
+            problem.components.iter().zip(errors).all(|(c, e)| e <= tolerance.of(c.variable));
         Ok(Solved {
             solver: SolverChoice::Rrt,
             trajectory: timed.trajectory,
@@ -397,9 +396,7 @@ impl Solver<'_> {
 
     /// Appends the segment's reference Pw at the output rate, in plan time.
     fn reference(&mut self, problem: &SegmentProblem, start: Real) {
-        let count = (problem.duration * self.rate).ceil().max(1.0) as usize;
-        for i in 0..=count {
-            let t = (i as Real / self.rate).min(problem.duration);
+        for t in trajectory::sample_times(0.0, problem.duration, self.rate) {
             if let Some(p) = reference_wrist(self.robot, problem, t) {
                 self.wrist_reference.push((start + t, p));
             }
@@ -418,9 +415,10 @@ impl Solver<'_> {
         start: Real,
     ) -> SegmentReport {
         let tolerance = &self.options.qp.tolerance;
-        let error = |variable: Variable, error: Real| {
-            let limit = if variable == Variable::Pw { tolerance.position } else { tolerance.angle };
-            VariableError { variable, error, within: error <= limit }
+        let error = |variable: Variable, error: Real| VariableError {
+            variable,
+            error,
+            within: error <= tolerance.of(variable),
         };
         let components = problem.components.iter();
         let errors = components.clone().zip(solution.errors).map(|(c, e)| error(c.variable, e));

@@ -19,7 +19,7 @@ use crate::kinematics::arm_pose;
 use crate::math::{JointVector, Real};
 use crate::profile::{BellProfile, JointSample};
 use crate::robot::Robot;
-use crate::trajectory::{Trajectory, TrajectoryError};
+use crate::trajectory::{Trajectory, TrajectoryError, sample_times};
 
 /// Settings of [`rrt_connect`].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -463,11 +463,7 @@ pub fn time_parameterise(
         }
         (q, JointVector::zeros())
     };
-    let count = (duration * rate).floor() as usize;
-    let mut times: Vec<Real> = (0..=count).map(|k| k as Real / rate).collect();
-    times.retain(|&t| t < duration - 1e-9 / rate);
-    times.push(duration);
-    let trajectory = Trajectory::from_fn(times, at)?;
+    let trajectory = Trajectory::from_fn(sample_times(0.0, duration, rate), at)?;
     Ok(TimedPath { trajectory, duration, stretched })
 }
 

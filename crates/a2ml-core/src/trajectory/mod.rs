@@ -2,8 +2,8 @@
 //! (DESIGN.md §4, §5) and the checks run on the whole result: joint limits and clearance.
 //!
 //! Entry points: [`Trajectory::new`], [`join_sequential`], [`join_transitional`],
-//! [`check_limits`], [`min_clearance`]. Between samples q follows the cubic Hermite curve
-//! through the samples' q and q', so the two stay consistent.
+//! [`check_limits`], [`min_clearance`], [`sample_times`] (the output grid). Between samples q
+//! follows the cubic Hermite curve through the samples' q and q', so the two stay consistent.
 
 use crate::collision::{self, CollisionScene};
 use crate::kinematics::arm_pose;
@@ -194,19 +194,24 @@ impl Trajectory {
         if !(rate_hz.is_finite() && rate_hz > 0.0) {
             return Err(TrajectoryError::InvalidRate { rate_hz });
         }
-        let step = 1.0 / rate_hz;
-        let count = (self.duration() / step).floor() as usize;
-        let mut times: Vec<Real> = (0..=count).map(|i| self.start() + i as Real * step).collect();
-        // Keep the end point exactly, dropping a grid point that rounds onto it.
-        times.retain(|&t| t < self.end() - 1e-9 * step);
-        times.push(self.end());
-        Self::from_fn(times, |t| self.sample(t))
+        Self::from_fn(sample_times(self.start(), self.end(), rate_hz), |t| self.sample(t))
     }
 
     /// `sample` in local time (0 at the first sample).
     fn local(&self) -> impl Fn(Real) -> JointSample + '_ {
         move |t| self.sample(self.start() + t)
     }
+}
+
+/// Times every 1/`rate_hz` s from `start`, then `end` exactly (a grid point within 1e-9 of
+/// a step of it is dropped). `rate_hz` must be positive and finite.
+pub fn sample_times(start: Real, end: Real, rate_hz: Real) -> Vec<Real> {
+    let step = 1.0 / rate_hz;
+    let count = ((end - start) / step).floor() as usize;
+    let mut times: Vec<Real> = (0..=count).map(|i| start + i as Real * step).collect();
+    times.retain(|&t| t < end - 1e-9 * step);
+    times.push(end);
+    times
 }
 
 /// Merges sorted time lists, dropping times within 1e-12 s of the one before.
