@@ -66,3 +66,19 @@ pub fn nearby(robot: &Robot, q: &JointVector, rng: &mut StdRng, spread: Real) ->
         (q[i] + rng.random_range(-spread..spread)).clamp(l.lower + 1e-3, l.upper - 1e-3)
     })
 }
+
+/// A file of the shipped examples/ folder.
+pub fn example(file: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples").join(file)
+}
+
+/// No joint outside its position range or speed limit at any sample.
+pub fn assert_within_limits(robot: &Robot, t: &a2ml::trajectory::Trajectory) {
+    let violations = a2ml::trajectory::check_limits(t, robot, 0.0);
+    assert!(
+        violations.is_empty(),
+        "{} limit violations, first {:?}",
+        violations.len(),
+        violations.first()
+    );
+}

@@ -11,6 +11,8 @@ use a2ml::decompose::{
 };
 use a2ml::language::{ActionBody, Space, Task, load, parse};
 
+use crate::common;
+
 /// Parses a task whose robot path is relative to the repository root.
 fn task(text: &str) -> Task {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("decompose_test.a2ml");
@@ -326,10 +328,6 @@ fn decompose_example(path: &Path) -> (Robot, Task, Result<Decomposition, Decompo
     (robot, task, decomposition)
 }
 
-fn example(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples").join(name)
-}
-
 /// Every shipped example decomposes with the default options, but for a
 /// file without `start` (construct_minimal.a2ml), which is valid yet has
 /// nowhere to plan from.
@@ -370,7 +368,7 @@ fn every_example_decomposes() {
 fn push_box_examples_run_the_papers_seven_actions_on_both_arms() {
     use ActionType::*;
     for name in ["push_box_aside_coman.a2ml", "push_box_aside_centauro.a2ml"] {
-        let (_, task, decomposition) = decompose_example(&example(name));
+        let (_, task, decomposition) = decompose_example(&common::example(name));
         let d = decomposition.unwrap_or_else(|e| panic!("{name}: {e}"));
         let names: Vec<&str> = d.actions.iter().map(|a| a.name.as_str()).collect();
         assert_eq!(names, PAPER_ORDER, "{name}");
@@ -400,7 +398,7 @@ fn contact_lets_an_action_reach_into_an_obstacle() {
         ))
         .replace("task t", "scene { ball = sphere at [0.2, -0.1, -0.2] radius 0.05 }\ntask t")
     };
-    let robot = Robot::from_urdf_file(crate::common::robot_path("coman_right_arm")).expect("robot");
+    let robot = Robot::from_urdf_file(common::robot_path("coman_right_arm")).expect("robot");
     let options = DecomposeOptions::default();
     let blocked = decompose(&robot, &task(&text("")), &options);
     assert!(matches!(blocked, Err(DecomposeError::Unreachable { .. })), "{blocked:?}");
@@ -413,7 +411,7 @@ fn contact_lets_an_action_reach_into_an_obstacle() {
 /// joint limit; the end state keeps `OptOptions::limit_margin` from it.
 #[test]
 fn opt_end_states_keep_the_limit_margin() {
-    let path = example("push_box_aside_coman.a2ml");
+    let path = common::example("push_box_aside_coman.a2ml");
     let (robot, task, _) = decompose_example(&path);
     let end_of_retract = |margin: f64| {
         let mut options = DecomposeOptions::default();

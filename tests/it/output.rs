@@ -16,7 +16,7 @@ use a2ml::solve::{Plan, QpStats, SegmentReport, VariableError};
 use a2ml::trajectory::{Clearance, Trajectory};
 use serde_json::Value;
 
-use crate::common::load;
+use crate::common::{self, load};
 
 /// Output rate of the test plan (Hz): above [`ARM_CAPSULE_RATE`], so capsules are thinned.
 const RATE: Real = 250.0;
@@ -25,13 +25,9 @@ const SAMPLES: usize = 101;
 /// Fields that may be null although their schema gives another type (see `schemas.rs`).
 const NULLABLE: [&str; 5] = ["cpsa", "hat", "action_type", "clearance", "rrt"];
 
-fn example(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples").join(name)
-}
-
 /// The task of an example file, with its source.
 fn task(name: &str) -> (Task, String) {
-    let path = example(name);
+    let path = common::example(name);
     let source = fs::read_to_string(&path).expect("example readable");
     (parse(&source, Some(&path)).expect("valid example"), source)
 }

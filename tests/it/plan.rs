@@ -1,8 +1,6 @@
 //! The velocity QP and whole plans, every sample re-checked independently of the solver:
 //! joint limits, clearance, path deviation and goal error by forward kinematics.
 
-use std::path::Path;
-
 use a2ml::Robot;
 use a2ml::collision::CollisionScene;
 use a2ml::kinematics::{ArmPose, arm_pose, cpsa_state};
@@ -11,17 +9,13 @@ use a2ml::math::{JointVector, Real, Rotation3, Vector3};
 use a2ml::profile::{Reference, Role};
 use a2ml::solve::qp::{Component, QpError, QpOptions, SegmentProblem, solve_segment};
 use a2ml::solve::{Plan, PlanOptions, SolveError, plan};
-use a2ml::trajectory::{self, Trajectory};
+use a2ml::trajectory;
 
 use crate::common;
 
-fn examples_dir() -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples")
-}
-
 /// A task from source text, as if it were a file in examples/ (for the robot path).
 fn task(source: &str) -> Task {
-    let path = examples_dir().join("inline.a2ml");
+    let path = common::example("inline.a2ml");
     language::parse(source, Some(&path)).unwrap_or_else(|d| panic!("{d}"))
 }
 
@@ -72,16 +66,6 @@ fn line_segment(
     }
 }
 
-fn assert_within_limits(robot: &Robot, t: &Trajectory) {
-    let violations = trajectory::check_limits(t, robot, 0.0);
-    assert!(
-        violations.is_empty(),
-        "{} limit violations, first {:?}",
-        violations.len(),
-        violations[0]
-    );
-}
-
 #[test]
 fn a_hard_line_is_kept_within_a_millimetre() {
     let robot = common::load("coman_right_arm");
@@ -101,7 +85,7 @@ fn a_hard_line_is_kept_within_a_millimetre() {
     let travelled =
         (wrist(&robot, dense.positions().last().expect("samples")) - p0).dot(&direction);
     assert!((travelled - 0.12).abs() < 1e-3, "{travelled}");
-    assert_within_limits(&robot, &dense);
+    common::assert_within_limits(&robot, &dense);
     // The report's own measure agrees with the re-check.
     assert!(solution.max_errors[0] < 1e-3);
 }
@@ -169,7 +153,7 @@ fn an_obstacle_across_the_wrist_path_stalls_the_qp_clear_of_it() {
     // Clear of it throughout, by an independent check of every output sample.
     let clearance = trajectory::min_clearance(&plan.trajectory, &robot, &scene).expect("pairs");
     assert!(clearance.distance >= plan.safety_distance, "{clearance:?}");
-    assert_within_limits(&robot, &plan.trajectory);
+    common::assert_within_limits(&robot, &plan.trajectory);
 }
 
 #[test]
@@ -177,11 +161,11 @@ fn limits_clearance_and_goals_hold_on_the_examples_that_plan() {
     for name in
         ["construct_path_line", "construct_path_about", "construct_path_by", "construct_units"]
     {
-        let task = language::load(examples_dir().join(format!("{name}.a2ml"))).expect("loads");
+        let task = language::load(common::example(&format!("{name}.a2ml"))).expect("loads");
         let robot = Robot::from_urdf_file(&task.robot).expect("robot");
         let plan = plan(&robot, &task, &PlanOptions::default()).expect("plans");
         assert!(plan.reached(), "{name}: {:?}", plan.warnings);
-        assert_within_limits(&robot, &plan.trajectory);
+        common::assert_within_limits(&robot, &plan.trajectory);
         check_goals(&robot, &task, &plan, name);
         let times = plan.trajectory.times();
         let step = 1.0 / plan.rate;
@@ -206,7 +190,7 @@ fn check_goals(robot: &Robot, task: &Task, plan: &Plan, name: &str) {
 
 #[test]
 fn the_same_task_plans_the_same_trajectory() {
-    let task = language::load(examples_dir().join("construct_path_about.a2ml")).expect("loads");
+    let task = language::load(common::example("construct_path_about.a2ml")).expect("loads");
     let robot = Robot::from_urdf_file(&task.robot).expect("robot");
     let a = plan(&robot, &task, &PlanOptions::default()).expect("plans");
     let b = plan(&robot, &task, &PlanOptions::default()).expect("plans");
@@ -216,7 +200,7 @@ fn the_same_task_plans_the_same_trajectory() {
 
 #[test]
 fn the_wrist_reference_starts_and_ends_where_the_plan_does() {
-    let task = language::load(examples_dir().join("construct_path_line.a2ml")).expect("loads");
+    let task = language::load(common::example("construct_path_line.a2ml")).expect("loads");
     let robot = Robot::from_urdf_file(&task.robot).expect("robot");
     let plan = plan(&robot, &task, &PlanOptions::default()).expect("plans");
     let shoulder = robot.structure.shoulder_in_base_link;
@@ -238,7 +222,7 @@ fn bad_settings_and_unavailable_solvers_are_errors() {
         solve_segment(&robot, &CollisionScene::new(&[]), &problem, &q0, &options),
         Err(QpError::InvalidOptions { .. })
     ));
-    let task = language::load(examples_dir().join("construct_path_line.a2ml")).expect("loads");
+    let task = language::load(common::example("construct_path_line.a2ml")).expect("loads");
     let robot = Robot::from_urdf_file(&task.robot).expect("robot");
     let options = PlanOptions { rate: Some(0.0), ..PlanOptions::default() };
     assert!(matches!(plan(&robot, &task, &options), Err(SolveError::InvalidRate { .. })));
@@ -268,12 +252,12 @@ fn obstacles_are_kept_at_the_safety_distance_when_the_path_grazes_them() {
     let dense = solution.trajectory.resample(1000.0).expect("resamples");
     let clearance = trajectory::min_clearance(&dense, &robot, &scene).expect("pairs");
     assert!(clearance.distance >= options.safety_distance, "{clearance:?}");
-    assert_within_limits(&robot, &dense);
+    common::assert_within_limits(&robot, &dense);
 }
 
 #[test]
 fn progress_is_reported_after_every_segment() {
-    let task = language::load(examples_dir().join("construct_path_about.a2ml")).expect("loads");
+    let task = language::load(common::example("construct_path_about.a2ml")).expect("loads");
     let robot = Robot::from_urdf_file(&task.robot).expect("robot");
     let mut seen = Vec::new();
     let plan = a2ml::solve::plan_with_progress(&robot, &task, &PlanOptions::default(), &mut |p| {
@@ -289,14 +273,14 @@ fn progress_is_reported_after_every_segment() {
 fn auto_gives_a_goal_among_obstacles_to_the_rrt_which_reaches_it_clear() {
     // The QP stalls on this one (see the stall test's twin, construct_scene): auto plans it
     // with the RRT instead.
-    let task = language::load(examples_dir().join("construct_scene.a2ml")).expect("loads");
+    let task = language::load(common::example("construct_scene.a2ml")).expect("loads");
     let robot = Robot::from_urdf_file(&task.robot).expect("robot");
     let planned = plan(&robot, &task, &PlanOptions::default()).expect("plans");
     let report = &planned.segments[0];
     assert_eq!(report.solver, language::SolverChoice::Rrt);
     assert!(report.rrt.is_some_and(|s| s.nodes >= 2 && s.collision_checks > 0));
     assert!(planned.reached(), "{:?}", planned.warnings);
-    assert_within_limits(&robot, &planned.trajectory);
+    common::assert_within_limits(&robot, &planned.trajectory);
     // Clear of every obstacle at 1 kHz, by an independent check.
     let scene = CollisionScene::new(&task.scene);
     let dense = planned.trajectory.resample(1000.0).expect("resamples");
@@ -324,7 +308,7 @@ fn plan_reached(robot: &Robot, task: &Task, options: &PlanOptions) -> bool {
 
 #[test]
 fn the_rrt_does_not_yet_plan_segments_with_paths() {
-    let task = language::load(examples_dir().join("construct_path_line.a2ml")).expect("loads");
+    let task = language::load(common::example("construct_path_line.a2ml")).expect("loads");
     let robot = Robot::from_urdf_file(&task.robot).expect("robot");
     let options =
         PlanOptions { solver: Some(language::SolverChoice::Rrt), ..PlanOptions::default() };

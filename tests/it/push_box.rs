@@ -7,19 +7,7 @@ use a2ml::language::{self, Task, Variable};
 use a2ml::math::Real;
 use a2ml::solve::{Plan, PlanOptions, plan};
 
-fn examples_dir() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples")
-}
-
-fn assert_within_limits(robot: &Robot, t: &a2ml::trajectory::Trajectory) {
-    let violations = a2ml::trajectory::check_limits(t, robot, 0.0);
-    assert!(
-        violations.is_empty(),
-        "{} limit violations, first {:?}",
-        violations.len(),
-        violations[0]
-    );
-}
+use crate::common;
 
 /// Paper §6.4 on both arms: every limit at every sample, clearance from every obstacle the
 /// action does not touch, every goal within 1 mm / 1°, and the same actions in the same order.
@@ -27,11 +15,11 @@ fn assert_within_limits(robot: &Robot, t: &a2ml::trajectory::Trajectory) {
 fn the_push_box_task_plans_on_both_arms() {
     let mut sequences = Vec::new();
     for name in ["push_box_aside_coman", "push_box_aside_centauro"] {
-        let task = language::load(examples_dir().join(format!("{name}.a2ml"))).expect("loads");
+        let task = language::load(common::example(&format!("{name}.a2ml"))).expect("loads");
         let robot = Robot::from_urdf_file(&task.robot).expect("robot");
         let plan = plan(&robot, &task, &PlanOptions::default()).expect("plans");
         assert!(plan.reached(), "{name}: {:?}", plan.warnings);
-        assert_within_limits(&robot, &plan.trajectory);
+        common::assert_within_limits(&robot, &plan.trajectory);
         let task_b = task.in_base_frame(&robot.structure.shoulder_in_base_link);
         for (i, action) in task_b.actions.iter().enumerate() {
             let reports: Vec<_> = plan.segments.iter().filter(|s| s.action_index == i).collect();
