@@ -1,6 +1,6 @@
 //! Capsule-obstacle distances against independent brute force.
 
-use crate::common::{load, random_q, rng};
+use crate::common::{all_robots, load, random_q, rng};
 use a2ml::collision::*;
 use a2ml::kinematics::arm_pose;
 use a2ml::language::{Obstacle, Shape};
@@ -170,4 +170,59 @@ fn empty_scene_keeps_self_pairs_only() {
         .sum();
     assert_eq!(all.len(), expected);
     assert_eq!(min_distance(&robot, &pose, &scene).is_some(), expected > 0);
+}
+
+#[test]
+fn the_collision_model_agrees_with_min_distance() {
+    for (name, robot) in all_robots() {
+        let mut rng = rng(23);
+        let mut close = 0;
+        for _ in 0..300 {
+            let scene = CollisionScene::new(&random_scene(&mut rng));
+            let model = CollisionModel::new(&robot, &scene);
+            for _ in 0..5 {
+                let q = random_q(&robot, &mut rng);
+                let (expected, link, obstacle) =
+                    min_distance(&robot, &arm_pose(&robot, &q), &scene).expect("pairs");
+                let found = clearance(&model, &q);
+                // parry's distance to a cylinder (o3) is iterative (GJK): rounding in the
+                // forward kinematics moves it by up to a few 1e-9.
+                let tolerance = if obstacle == "o3" { 1e-8 } else { TOL };
+                assert!(
+                    (found - expected).abs() < tolerance,
+                    "{name}: {found} vs {expected} ({link}, {obstacle})"
+                );
+                if expected < 0.05 {
+                    close += 1;
+                }
+            }
+        }
+        assert!(close > 100, "{name}: too few close or penetrating configurations: {close}");
+    }
+}
+
+#[test]
+fn advancement_keeps_the_clearance_either_way() {
+    for (name, robot) in all_robots() {
+        let mut rng = rng(29);
+        for _ in 0..200 {
+            let scene = CollisionScene::new(&random_scene(&mut rng));
+            let model = CollisionModel::new(&robot, &scene);
+            let q = random_q(&robot, &mut rng);
+            let dq = random_q(&robot, &mut rng) - q;
+            let kept = rng.random_range(0.0..0.05);
+            let s = advancement(&model, &q, &dq, kept);
+            let d = |q| {
+                min_distance(&robot, &arm_pose(&robot, &q), &scene).map_or(Real::INFINITY, |m| m.0)
+            };
+            assert_eq!(s < 0.0, d(q) < kept, "{name}: {s} at {}", d(q));
+            if s <= 0.0 || !s.is_finite() {
+                continue;
+            }
+            for k in -20..=20 {
+                let t = s * k as Real / 20.0;
+                assert!(d(q + dq * t) >= kept - TOL, "{name}: at {t} of {s}");
+            }
+        }
+    }
 }

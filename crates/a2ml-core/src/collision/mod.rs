@@ -2,7 +2,9 @@
 //! every solver that keeps the arm clear (Opt1/Opt2, the velocity QP, RRT).
 //!
 //! Entry points: [`CollisionScene::new`], [`arm_capsules`], [`distances`],
-//! [`min_distance`]. Everything is in {b}, SI units. parry enters the crate
+//! [`min_distance`]; for many configurations of one scene (sampling
+//! planners), [`CollisionModel`] with [`clearance`], [`advancement`] and
+//! [`motion_bound`]. Everything is in {b}, SI units. parry enters the crate
 //! here only; its glam types never leave this module.
 
 use parry3d_f64::math::{Pose, Vector};
@@ -13,6 +15,10 @@ use crate::kinematics::ArmPose;
 use crate::language::{Obstacle, Shape};
 use crate::math::{Real, Vector3};
 use crate::robot::{LinkRole, Robot};
+
+mod model;
+
+pub use model::{CollisionModel, advancement, clearance, motion_bound};
 
 /// The task's obstacles as parry shapes, positioned in {b}.
 ///

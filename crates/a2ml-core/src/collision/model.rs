@@ -1,0 +1,455 @@
+//! [`CollisionModel`]: the arm's capsules and a scene prepared once for queries at many
+//! configurations, without allocating: closed-form capsule–sphere and capsule–capsule
+//! distances, parry only for boxes and cylinders.
+
+use parry3d_f64::math::Pose;
+use parry3d_f64::query;
+use parry3d_f64::shape::Segment;
+
+use super::{Body, CollisionScene, Core, self_pairs, to_parry};
+use crate::math::{DOF, JointVector, Matrix3, PI, Real, Rotation3, Vector3};
+use crate::robot::{LinkRole, Robot};
+
+/// The arm's capsules and a scene's obstacles, prepared for [`clearance`] and
+/// [`advancement`] at many configurations.
+///
+/// It considers the same pairs as [`super::min_distance`]: every moving link capsule against
+/// every obstacle, plus [`self_pairs`].
+#[derive(Debug, Clone)]
+pub struct CollisionModel {
+    chain: Chain,
+    links: Vec<LinkCapsule>,
+    /// Indices into `links` of the capsules that move.
+    moving: Vec<usize>,
+    spheres: Vec<Sphere>,
+    capsules: Vec<Capsule>,
+    /// Boxes and cylinders, through parry.
+    convex: Vec<Body>,
+    self_pairs: Vec<SelfPair>,
+}
+
+/// A robot capsule in its moving frame.
+#[derive(Debug, Clone)]
+struct LinkCapsule {
+    frame: usize,
+    /// Segment ends in the aligned frame (see [`Chain`]).
+    a: Vector3,
+    b: Vector3,
+    radius: Real,
+    /// Per joint, how far any point of the segment can be from the joint's axis (m), over all
+    /// configurations: the segment moves at most Σ levers_j |Δq_j| along a straight
+    /// joint-space motion Δq.
+    levers: JointVector,
+}
+
+/// A self-collision pair: `link` moving, `other` treated as the obstacle.
+#[derive(Debug, Clone)]
+struct SelfPair {
+    link: usize,
+    other: usize,
+    /// The levers of `link` for the joints that move it relative to `other` (those between
+    /// their two frames), zero for the others: the joints before both move them as one.
+    levers: JointVector,
+}
+
+#[derive(Debug, Clone)]
+struct Sphere {
+    center: Vector3,
+    radius: Real,
+}
+
+#[derive(Debug, Clone)]
+struct Capsule {
+    a: Vector3,
+    b: Vector3,
+    radius: Real,
+}
+
+impl CollisionModel {
+    /// Prepares `robot`'s capsules against `scene`.
+    pub fn new(robot: &Robot, scene: &CollisionScene) -> Self {
+        let last = robot.capsules.iter().map(|c| c.frame).max().unwrap_or(0);
+        let chain = Chain::new(robot, last);
+        let links: Vec<LinkCapsule> = robot
+            .capsules
+            .iter()
+            .map(|c| LinkCapsule {
+                frame: c.frame,
+                a: chain.aligned_from_frame[c.frame] * c.a,
+                b: chain.aligned_from_frame[c.frame] * c.b,
+                radius: c.radius,
+                levers: levers(robot, c.frame, &c.a, &c.b),
+            })
+            .collect();
+        let role = |i: usize| robot.capsules[i].role;
+        let moving = (0..links.len()).filter(|&i| role(i) != LinkRole::Base).collect();
+        let count = links.len();
+        let with_role = move |r: LinkRole| (0..count).filter(move |&i| role(i) == r);
+        let self_pairs = self_pairs()
+            .iter()
+            .flat_map(|&(moving, against)| {
+                with_role(moving).flat_map(move |i| with_role(against).map(move |j| (i, j)))
+            })
+            .map(|(link, other)| {
+                let (near, far) = (links[link].frame, links[other].frame);
+                let between = near.min(far)..near.max(far);
+                let levers = JointVector::from_fn(|j, _| {
+                    if between.contains(&j) { links[link].levers[j] } else { 0.0 }
+                });
+                SelfPair { link, other, levers }
+            })
+            .collect();
+        let (mut spheres, mut capsules, mut convex) = (Vec::new(), Vec::new(), Vec::new());
+        for body in &scene.bodies {
+            match body.shape {
+                Core::Ball(ball) => {
+                    let t = body.pose.translation;
+                    spheres
+                        .push(Sphere { center: Vector3::new(t.x, t.y, t.z), radius: ball.radius })
+                }
+                Core::Segment(s) => capsules.push(Capsule {
+                    a: Vector3::new(s.a.x, s.a.y, s.a.z),
+                    b: Vector3::new(s.b.x, s.b.y, s.b.z),
+                    radius: body.margin,
+                }),
+                Core::Cuboid(_) | Core::Cylinder(_) => convex.push(body.clone()),
+            }
+        }
+        Self { chain, links, moving, spheres, capsules, convex, self_pairs }
+    }
+}
+
+/// The smallest signed distance (m, negative for a penetration) over the pairs of
+/// [`super::min_distance`] with the arm at `q`; ∞ when there is no pair.
+pub fn clearance(model: &CollisionModel, q: &JointVector) -> Real {
+    model.smallest(q, 0.0, |_| 1.0, |_| 1.0)
+}
+
+/// How far the arm at `q` can move along the straight joint-space motion `dq`, either way,
+/// while keeping `clearance` (m) from the scene and between the self-collision pairs: every
+/// configuration q ± s·dq with s up to the result keeps it.
+///
+/// Conservative advancement: a point of a capsule moves at most Σ_j lever_j |dq_j| per unit
+/// of s (lever_j bounding its distance from joint j's axis), an obstacle stands still, and the
+/// two capsules of a self pair move relative to each other only by the joints between them;
+/// so a pair at distance d approaching at that rate keeps the clearance for
+/// (d − clearance) / rate. Negative when some pair is already closer than `clearance`; ∞ when
+/// no pair can approach.
+pub fn advancement(
+    model: &CollisionModel,
+    q: &JointVector,
+    dq: &JointVector,
+    clearance: Real,
+) -> Real {
+    let dq = dq.abs();
+    model.smallest(
+        q,
+        clearance,
+        |link| model.links[link].levers.dot(&dq),
+        |pair| pair.levers.dot(&dq),
+    )
+}
+
+/// The farthest any point of the arm's capsule segments moves along the straight joint-space
+/// motion `dq` (m), from any configuration.
+pub fn motion_bound(model: &CollisionModel, dq: &JointVector) -> Real {
+    let dq = dq.abs();
+    model.links.iter().map(|l| l.levers.dot(&dq)).fold(0.0, Real::max)
+}
+
+impl CollisionModel {
+    /// The smallest (d − offset) / rate over the pairs, where d is the signed distance of a
+    /// pair and its rate is `obstacle_rate(link)` against an obstacle and `self_rate(pair)`
+    /// for a self pair. A pair whose rate is zero counts as ∞ if d ≥ offset and −∞ otherwise.
+    fn smallest(
+        &self,
+        q: &JointVector,
+        offset: Real,
+        obstacle_rate: impl Fn(usize) -> Real,
+        self_rate: impl Fn(&SelfPair) -> Real,
+    ) -> Real {
+        let frames = self.chain.frames(q);
+        let mut best = Real::INFINITY;
+        for &i in &self.moving {
+            let link = self.links[i].posed(&frames);
+            let rate = obstacle_rate(i);
+            // Only distances (between the segment and an obstacle's core) below this can
+            // lower `best`.
+            let mut below = improving(best, rate, offset) + link.radius;
+            let take = |distance: Real, best: &mut Real, below: &mut Real| {
+                *best = best.min(scaled(distance - link.radius - offset, rate));
+                *below = improving(*best, rate, offset) + link.radius;
+            };
+            for sphere in &self.spheres {
+                let reach = below + sphere.radius;
+                if reach > 0.0 {
+                    let squared = link.squared_distance_to_point(&sphere.center);
+                    if squared < reach * reach {
+                        take(squared.sqrt() - sphere.radius, &mut best, &mut below);
+                    }
+                }
+            }
+            for capsule in &self.capsules {
+                let reach = below + capsule.radius;
+                if reach > 0.0 {
+                    let distance =
+                        segment_segment_distance(&link.a, &link.b, &capsule.a, &capsule.b);
+                    if distance < reach {
+                        take(distance - capsule.radius, &mut best, &mut below);
+                    }
+                }
+            }
+            for body in &self.convex {
+                let gap = (link.center - body.center).norm() - link.bound - body.bound;
+                if gap < below - link.radius {
+                    if let Some(distance) = link.convex_distance(body, below) {
+                        take(distance, &mut best, &mut below);
+                    }
+                }
+            }
+        }
+        for pair in &self.self_pairs {
+            let rate = self_rate(pair);
+            let (link, other) =
+                (self.links[pair.link].posed(&frames), self.links[pair.other].posed(&frames));
+            if scaled(link.gap_bound(&other) - offset, rate) < best {
+                best = best.min(scaled(link.distance(&other) - offset, rate));
+            }
+        }
+        best
+    }
+}
+
+/// The signed distance below which a pair approaching at `rate` lowers `best`, offset
+/// included.
+fn improving(best: Real, rate: Real, offset: Real) -> Real {
+    if rate > 0.0 {
+        best * rate + offset
+    } else if best > Real::NEG_INFINITY {
+        offset
+    } else {
+        Real::NEG_INFINITY
+    }
+}
+
+/// `slack / rate`, with a pair that does not approach (rate 0) never losing its slack.
+fn scaled(slack: Real, rate: Real) -> Real {
+    if rate > 0.0 {
+        slack / rate
+    } else if slack >= 0.0 {
+        Real::INFINITY
+    } else {
+        Real::NEG_INFINITY
+    }
+}
+
+/// Per joint, a bound on the distance of the segment a–b (in moving frame `frame`) from the
+/// joint's axis over all configurations. Joint j turns frames j+1..; its axis passes through
+/// the origin of frame j+1, and from there to frame `frame`'s origin are at most the joint
+/// offsets between. The last joint before the frame turns it about the axis itself, so there
+/// the exact distance from the axis is used.
+fn levers(robot: &Robot, frame: usize, a: &Vector3, b: &Vector3) -> JointVector {
+    let offsets: Vec<Real> =
+        robot.joints.iter().map(|j| j.parent_from_joint.translation.vector.norm()).collect();
+    let reach = a.norm().max(b.norm());
+    JointVector::from_fn(|j, _| {
+        if j + 1 > frame {
+            0.0
+        } else if j + 1 == frame {
+            let axis = robot.joints[j].axis;
+            let off_axis = |p: &Vector3| (p - axis * axis.dot(p)).norm();
+            off_axis(a).max(off_axis(b))
+        } else {
+            offsets[j + 1..frame].iter().sum::<Real>() + reach
+        }
+    })
+}
+
+/// Forward kinematics of the moving frames up to the last carrying a capsule, in aligned
+/// frames: each frame k+1 turned so that the axis of joint k is its z, which makes a joint's
+/// turn a two-column update and folds the joint axes into constant transforms.
+///
+/// With F the moving frames of [`crate::kinematics::arm_pose`] and A_k a rotation taking z onto
+/// joint k's axis u_k: R(u_k, q) A_k = A_k Rz(q), so the aligned frame G_{k+1} = F_{k+1} A_k is
+/// G_k (A_{k−1}ᵀ P_k A_k) Rz(q_k), P_k being the joint's parent-from-joint transform.
+#[derive(Debug, Clone)]
+struct Chain {
+    /// A_{k−1}ᵀ P_k A_k per joint, up to the last frame needed.
+    steps: Vec<Frame>,
+    /// A_{k−1}ᵀ per frame k (the identity for {b}).
+    aligned_from_frame: [Matrix3; DOF + 1],
+}
+
+/// A rigid transform: rotation then translation.
+#[derive(Debug, Clone, Copy)]
+struct Frame {
+    rotation: Matrix3,
+    translation: Vector3,
+}
+
+impl Frame {
+    fn identity() -> Self {
+        Self { rotation: Matrix3::identity(), translation: Vector3::zeros() }
+    }
+
+    fn apply(&self, p: &Vector3) -> Vector3 {
+        self.rotation * p + self.translation
+    }
+}
+
+impl Chain {
+    fn new(robot: &Robot, last: usize) -> Self {
+        let z = Vector3::z();
+        let align: Vec<Matrix3> = robot
+            .joints
+            .iter()
+            .map(|j| {
+                Rotation3::rotation_between(&z, &j.axis)
+                    // The axis is -z: half a turn about x.
+                    .unwrap_or_else(|| Rotation3::from_axis_angle(&Vector3::x_axis(), PI))
+                    .into_inner()
+            })
+            .collect();
+        let mut aligned_from_frame = [Matrix3::identity(); DOF + 1];
+        for k in 1..=DOF {
+            aligned_from_frame[k] = align[k - 1].transpose();
+        }
+        let steps = robot.joints[..last]
+            .iter()
+            .enumerate()
+            .map(|(k, joint)| {
+                let p = &joint.parent_from_joint;
+                let before = aligned_from_frame[k];
+                Frame {
+                    rotation: before * p.rotation.matrix() * align[k],
+                    translation: before * p.translation.vector,
+                }
+            })
+            .collect();
+        Self { steps, aligned_from_frame }
+    }
+
+    /// The aligned frames at `q`, `b_from_aligned`; those past the last needed are left at
+    /// the identity.
+    fn frames(&self, q: &JointVector) -> [Frame; DOF + 1] {
+        let mut frames = [Frame::identity(); DOF + 1];
+        for (k, step) in self.steps.iter().enumerate() {
+            let parent = frames[k];
+            let m = parent.rotation * step.rotation;
+            let (s, c) = q[k].sin_cos();
+            let (x, y) = (m.column(0), m.column(1));
+            frames[k + 1] = Frame {
+                rotation: Matrix3::from_columns(&[
+                    x * c + y * s,
+                    y * c - x * s,
+                    m.column(2).into(),
+                ]),
+                translation: parent.translation + parent.rotation * step.translation,
+            };
+        }
+        frames
+    }
+}
+
+/// A capsule placed in {b}, with its bounding sphere.
+struct Posed {
+    a: Vector3,
+    b: Vector3,
+    radius: Real,
+    center: Vector3,
+    bound: Real,
+}
+
+impl LinkCapsule {
+    fn posed(&self, frames: &[Frame; DOF + 1]) -> Posed {
+        let frame = &frames[self.frame];
+        Posed::new(frame.apply(&self.a), frame.apply(&self.b), self.radius)
+    }
+}
+
+impl Posed {
+    fn new(a: Vector3, b: Vector3, radius: Real) -> Self {
+        Self { a, b, radius, center: 0.5 * (a + b), bound: 0.5 * (b - a).norm() + radius }
+    }
+
+    /// A lower bound of the distance to `other` from the bounding spheres.
+    fn gap_bound(&self, other: &Posed) -> Real {
+        (self.center - other.center).norm() - self.bound - other.bound
+    }
+
+    /// Signed distance to another capsule.
+    fn distance(&self, other: &Posed) -> Real {
+        segment_segment_distance(&self.a, &self.b, &other.a, &other.b) - self.radius - other.radius
+    }
+}
+
+impl Posed {
+    /// The squared distance from the segment to `p`.
+    fn squared_distance_to_point(&self, p: &Vector3) -> Real {
+        (closest_on_segment(&self.a, &self.b, p) - p).norm_squared()
+    }
+
+    /// The distance from the segment to a parry body, if below `below`.
+    fn convex_distance(&self, body: &Body, below: Real) -> Option<Real> {
+        let segment = Segment::new(to_parry(&self.a), to_parry(&self.b));
+        // Without a bound, far enough to always find the pair: the farthest two points of
+        // the bounding spheres.
+        let reach = (self.center - body.center).norm() + self.bound + body.bound + 1.0;
+        let prediction = below.clamp(0.0, reach);
+        let contact =
+            query::contact(&body.pose, body.shape.as_dyn(), &Pose::IDENTITY, &segment, prediction);
+        // Every pair of shapes here is supported by parry's default dispatcher.
+        contact.ok().flatten().map(|c| c.dist)
+    }
+}
+
+/// The closest point of the segment a–b to `p`.
+pub(super) fn closest_on_segment(a: &Vector3, b: &Vector3, p: &Vector3) -> Vector3 {
+    let ab = b - a;
+    let length2 = ab.norm_squared();
+    if length2 <= Real::MIN_POSITIVE {
+        return *a;
+    }
+    a + ab * ((p - a).dot(&ab) / length2).clamp(0.0, 1.0)
+}
+
+/// Distance between the segments p1–q1 and p2–q2 (Ericson, Real-Time Collision Detection
+/// §5.1.9).
+pub(super) fn segment_segment_distance(
+    p1: &Vector3,
+    q1: &Vector3,
+    p2: &Vector3,
+    q2: &Vector3,
+) -> Real {
+    let (d1, d2, r) = (q1 - p1, q2 - p2, p1 - p2);
+    let (a, e, f) = (d1.norm_squared(), d2.norm_squared(), d2.dot(&r));
+    let tiny = Real::MIN_POSITIVE;
+    let (s, t) = if a <= tiny && e <= tiny {
+        (0.0, 0.0)
+    } else if a <= tiny {
+        (0.0, (f / e).clamp(0.0, 1.0))
+    } else {
+        let c = d1.dot(&r);
+        if e <= tiny {
+            ((-c / a).clamp(0.0, 1.0), 0.0)
+        } else {
+            let b = d1.dot(&d2);
+            let denominator = a * e - b * b;
+            // Parallel segments: any s works; start from p1.
+            let s = if denominator > 0.0 {
+                ((b * f - c * e) / denominator).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let t = (b * s + f) / e;
+            if t < 0.0 {
+                ((-c / a).clamp(0.0, 1.0), 0.0)
+            } else if t > 1.0 {
+                (((b - c) / a).clamp(0.0, 1.0), 1.0)
+            } else {
+                (s, t)
+            }
+        }
+    };
+    ((p1 + d1 * s) - (p2 + d2 * t)).norm()
+}
