@@ -47,9 +47,11 @@ struct LinkCapsule {
 struct SelfPair {
     link: usize,
     other: usize,
-    /// The levers of `link` for the joints that move it relative to `other` (those between
-    /// their two frames), zero for the others: the joints before both move them as one.
-    levers: JointVector,
+    /// The one of the two farther along the chain.
+    distal: usize,
+    /// The joints between the two frames: only they move one capsule relative to the other
+    /// (the joints before both move them as one).
+    joints: std::ops::Range<usize>,
 }
 
 #[derive(Debug, Clone)]
@@ -91,12 +93,9 @@ impl CollisionModel {
                 with_role(moving).flat_map(move |i| with_role(against).map(move |j| (i, j)))
             })
             .map(|(link, other)| {
-                let (near, far) = (links[link].frame, links[other].frame);
-                let between = near.min(far)..near.max(far);
-                let levers = JointVector::from_fn(|j, _| {
-                    if between.contains(&j) { links[link].levers[j] } else { 0.0 }
-                });
-                SelfPair { link, other, levers }
+                let (f, g) = (links[link].frame, links[other].frame);
+                let distal = if f >= g { link } else { other };
+                SelfPair { link, other, distal, joints: f.min(g)..f.max(g) }
             })
             .collect();
         let (mut spheres, mut capsules, mut convex) = (Vec::new(), Vec::new(), Vec::new());
@@ -122,18 +121,20 @@ impl CollisionModel {
 /// The smallest signed distance (m, negative for a penetration) over the pairs of
 /// [`super::min_distance`] with the arm at `q`; ∞ when there is no pair.
 pub fn clearance(model: &CollisionModel, q: &JointVector) -> Real {
-    model.smallest(q, 0.0, |_| 1.0, |_| 1.0)
+    model.smallest(q, 0.0, None)
 }
 
 /// How far the arm at `q` can move along the straight joint-space motion `dq`, either way,
 /// while keeping `clearance` (m) from the scene and between the self-collision pairs: every
 /// configuration q ± s·dq with s up to the result keeps it.
 ///
-/// Conservative advancement: a point of a capsule moves at most Σ_j lever_j |dq_j| per unit
-/// of s (lever_j bounding its distance from joint j's axis), an obstacle stands still, and the
-/// two capsules of a self pair move relative to each other only by the joints between them;
-/// so a pair at distance d approaching at that rate keeps the clearance for
-/// (d − clearance) / rate. Negative when some pair is already closer than `clearance`; ∞ when
+/// Conservative advancement. A point p of a capsule moves at the speed Σ_j |dq_j| r_j, r_j its
+/// distance from joint j's axis: at most the lever bounding r_j over all configurations, and
+/// near q at most r_j(q) plus what the joints after j have moved p since, so p moves at most
+/// min(Σ lever_j |dq_j| s, Σ r_j(q) |dq_j| s + Σ_{k>j} lever_k |dq_k| |dq_j| s² / 2) over s.
+/// An obstacle stands still, and the capsules of a self pair move relative to each other only
+/// by the joints between them; a pair at distance d keeps the clearance until that motion
+/// reaches d − clearance. Negative when some pair is already closer than `clearance`; ∞ when
 /// no pair can approach.
 pub fn advancement(
     model: &CollisionModel,
@@ -141,13 +142,7 @@ pub fn advancement(
     dq: &JointVector,
     clearance: Real,
 ) -> Real {
-    let dq = dq.abs();
-    model.smallest(
-        q,
-        clearance,
-        |link| model.links[link].levers.dot(&dq),
-        |pair| pair.levers.dot(&dq),
-    )
+    model.smallest(q, clearance, Some(&dq.abs()))
 }
 
 /// The farthest any point of the arm's capsule segments moves along the straight joint-space
@@ -158,27 +153,27 @@ pub fn motion_bound(model: &CollisionModel, dq: &JointVector) -> Real {
 }
 
 impl CollisionModel {
-    /// The smallest (d − offset) / rate over the pairs, where d is the signed distance of a
-    /// pair and its rate is `obstacle_rate(link)` against an obstacle and `self_rate(pair)`
-    /// for a self pair. A pair whose rate is zero counts as ∞ if d ≥ offset and −∞ otherwise.
-    fn smallest(
-        &self,
-        q: &JointVector,
-        offset: Real,
-        obstacle_rate: impl Fn(usize) -> Real,
-        self_rate: impl Fn(&SelfPair) -> Real,
-    ) -> Real {
+    /// The smallest `reach(d − offset)` over the pairs, d the signed distance of a pair and
+    /// `reach` the advancement its [`Motion`] along `speed` (|dq|) allows; with no motion,
+    /// the smallest d − offset.
+    fn smallest(&self, q: &JointVector, offset: Real, speed: Option<&JointVector>) -> Real {
         let frames = self.chain.frames(q);
+        let motion = |link: &Posed, mover: &LinkCapsule, joints: std::ops::Range<usize>| {
+            speed.map_or(Motion::UNIT, |speed| {
+                Motion::new(&frames, link, &mover.levers, speed, joints)
+            })
+        };
         let mut best = Real::INFINITY;
         for &i in &self.moving {
-            let link = self.links[i].posed(&frames);
-            let rate = obstacle_rate(i);
+            let capsule = &self.links[i];
+            let link = capsule.posed(&frames);
+            let motion = motion(&link, capsule, 0..capsule.frame);
             // Only distances (between the segment and an obstacle's core) below this can
             // lower `best`.
-            let mut below = improving(best, rate, offset) + link.radius;
+            let mut below = offset + motion.threshold(best) + link.radius;
             let take = |distance: Real, best: &mut Real, below: &mut Real| {
-                *best = best.min(scaled(distance - link.radius - offset, rate));
-                *below = improving(*best, rate, offset) + link.radius;
+                *best = best.min(motion.reach(distance - link.radius - offset));
+                *below = offset + motion.threshold(*best) + link.radius;
             };
             for sphere in &self.spheres {
                 let reach = below + sphere.radius;
@@ -209,37 +204,87 @@ impl CollisionModel {
             }
         }
         for pair in &self.self_pairs {
-            let rate = self_rate(pair);
             let (link, other) =
                 (self.links[pair.link].posed(&frames), self.links[pair.other].posed(&frames));
-            if scaled(link.gap_bound(&other) - offset, rate) < best {
-                best = best.min(scaled(link.distance(&other) - offset, rate));
+            let mover = &self.links[pair.distal];
+            let moved = if pair.distal == pair.link { &link } else { &other };
+            let motion = motion(moved, mover, pair.joints.clone());
+            if link.gap_bound(&other) - offset < motion.threshold(best) {
+                best = best.min(motion.reach(link.distance(&other) - offset));
             }
         }
         best
     }
 }
 
-/// The signed distance below which a pair approaching at `rate` lowers `best`, offset
-/// included.
-fn improving(best: Real, rate: Real, offset: Real) -> Real {
-    if rate > 0.0 {
-        best * rate + offset
-    } else if best > Real::NEG_INFINITY {
-        offset
-    } else {
-        Real::NEG_INFINITY
-    }
+/// A bound on how far the points of a capsule (or of one capsule relative to another) move
+/// over s units of a joint-space motion: min(bound·s, linear·s + quadratic·s²/2).
+#[derive(Debug, Clone, Copy)]
+struct Motion {
+    bound: Real,
+    linear: Real,
+    quadratic: Real,
 }
 
-/// `slack / rate`, with a pair that does not approach (rate 0) never losing its slack.
-fn scaled(slack: Real, rate: Real) -> Real {
-    if rate > 0.0 {
-        slack / rate
-    } else if slack >= 0.0 {
-        Real::INFINITY
-    } else {
-        Real::NEG_INFINITY
+impl Motion {
+    /// The distance itself: s is in metres.
+    const UNIT: Self = Self { bound: 1.0, linear: 1.0, quadratic: 0.0 };
+
+    /// The motion of the segment `link` (posed at `frames`, with `levers` bounding its
+    /// distances from the joint axes) by the `joints` given, at joint speeds `speed` (|dq|).
+    fn new(
+        frames: &[Frame; DOF + 1],
+        link: &Posed,
+        levers: &JointVector,
+        speed: &JointVector,
+        joints: std::ops::Range<usize>,
+    ) -> Self {
+        let (mut bound, mut linear, mut quadratic, mut before) = (0.0, 0.0, 0.0, 0.0);
+        for j in joints {
+            // Joint j turns about the z of aligned frame j+1, through its origin.
+            let axis = &frames[j + 1];
+            let off_axis = |p: &Vector3| {
+                let r = p - axis.translation;
+                let along = r.dot(&axis.rotation.column(2));
+                r.norm_squared() - along * along
+            };
+            let r = off_axis(&link.a).max(off_axis(&link.b)).max(0.0).sqrt();
+            bound += levers[j] * speed[j];
+            linear += r * speed[j];
+            // What the joints before j add to their distance from their axes as j turns.
+            quadratic += levers[j] * speed[j] * before;
+            before += speed[j];
+        }
+        Self { bound, linear, quadratic }
+    }
+
+    /// The largest s whose motion stays within `slack` (m): negative for a negative slack,
+    /// ∞ when nothing moves.
+    fn reach(&self, slack: Real) -> Real {
+        if self.bound <= 0.0 {
+            return if slack >= 0.0 { Real::INFINITY } else { Real::NEG_INFINITY };
+        }
+        if slack <= 0.0 {
+            return slack / self.bound;
+        }
+        let curved = 2.0 * slack
+            / (self.linear + (self.linear * self.linear + 2.0 * self.quadratic * slack).sqrt());
+        curved.max(slack / self.bound)
+    }
+
+    /// The slack below which [`Motion::reach`] is below `s`.
+    fn threshold(&self, s: Real) -> Real {
+        if s == Real::NEG_INFINITY {
+            Real::NEG_INFINITY
+        } else if self.bound <= 0.0 {
+            0.0
+        } else if s <= 0.0 {
+            s * self.bound
+        } else if s == Real::INFINITY {
+            Real::INFINITY
+        } else {
+            (self.bound * s).min(self.linear * s + 0.5 * self.quadratic * s * s)
+        }
     }
 }
 
@@ -404,7 +449,7 @@ impl Posed {
 }
 
 /// The closest point of the segment a–b to `p`.
-pub(super) fn closest_on_segment(a: &Vector3, b: &Vector3, p: &Vector3) -> Vector3 {
+fn closest_on_segment(a: &Vector3, b: &Vector3, p: &Vector3) -> Vector3 {
     let ab = b - a;
     let length2 = ab.norm_squared();
     if length2 <= Real::MIN_POSITIVE {
@@ -415,12 +460,7 @@ pub(super) fn closest_on_segment(a: &Vector3, b: &Vector3, p: &Vector3) -> Vecto
 
 /// Distance between the segments p1–q1 and p2–q2 (Ericson, Real-Time Collision Detection
 /// §5.1.9).
-pub(super) fn segment_segment_distance(
-    p1: &Vector3,
-    q1: &Vector3,
-    p2: &Vector3,
-    q2: &Vector3,
-) -> Real {
+fn segment_segment_distance(p1: &Vector3, q1: &Vector3, p2: &Vector3, q2: &Vector3) -> Real {
     let (d1, d2, r) = (q1 - p1, q2 - p2, p1 - p2);
     let (a, e, f) = (d1.norm_squared(), d2.norm_squared(), d2.dot(&r));
     let tiny = Real::MIN_POSITIVE;
@@ -453,3 +493,6 @@ pub(super) fn segment_segment_distance(
     };
     ((p1 + d1 * s) - (p2 + d2 * t)).norm()
 }
+
+#[cfg(test)]
+mod tests;

@@ -116,37 +116,3 @@ fn prediction_filters_far_pairs() {
     assert!(proximity(&link(), &o, 0.71).is_some());
     assert!(bounding_gap(&link(), &o) <= 0.7);
 }
-
-/// parry's distance between two segments, for reference.
-fn parry_segments(p1: &Vector3, q1: &Vector3, p2: &Vector3, q2: &Vector3) -> Real {
-    let segment = |a: &Vector3, b: &Vector3| Segment::new(to_parry(a), to_parry(b));
-    query::distance(&Pose::IDENTITY, &segment(p1, q1), &Pose::IDENTITY, &segment(p2, q2))
-        .expect("segments are supported")
-        .distance
-}
-
-#[test]
-fn segment_distances_match_parry() {
-    use rand::{RngExt, SeedableRng};
-    let mut rng = rand::rngs::StdRng::seed_from_u64(5);
-    let mut point =
-        || v(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
-    for k in 0..5000 {
-        let (p1, q1, p2, w) = (point(), point(), point(), point());
-        // Parallel, degenerate, crossing and general second segments.
-        let (p2, q2) = match k % 5 {
-            0 => (p2, p2 + (q1 - p1) * 0.7),
-            1 => (p2, p2),
-            2 => (p1 + (q1 - p1) * 0.3 + w, p1 + (q1 - p1) * 0.3 - w),
-            _ => (p2, w),
-        };
-        let expected = parry_segments(&p1, &q1, &p2, &q2);
-        let found = model::segment_segment_distance(&p1, &q1, &p2, &q2);
-        assert!((found - expected).abs() < TOL, "{k}: {found} vs {expected}");
-        let on = model::closest_on_segment(&p1, &q1, &p2);
-        assert!(((on - p2).norm() - parry_segments(&p1, &q1, &p2, &p2)).abs() < TOL);
-    }
-    // A degenerate first segment too.
-    let (p, a, b) = (v(0.0, 0.0, 1.0), v(-1.0, 0.0, 0.0), v(1.0, 0.0, 0.0));
-    assert!((model::segment_segment_distance(&p, &p, &a, &b) - 1.0).abs() < TOL);
-}

@@ -1,0 +1,102 @@
+use parry3d_f64::math::Pose;
+use parry3d_f64::query;
+use parry3d_f64::shape::Segment;
+use rand::{RngExt, SeedableRng};
+
+use super::*;
+use crate::collision::to_parry;
+
+const TOL: Real = 1e-9;
+
+fn v(x: Real, y: Real, z: Real) -> Vector3 {
+    Vector3::new(x, y, z)
+}
+
+/// parry's distance between two segments, for reference.
+fn parry_segments(p1: &Vector3, q1: &Vector3, p2: &Vector3, q2: &Vector3) -> Real {
+    let segment = |a: &Vector3, b: &Vector3| Segment::new(to_parry(a), to_parry(b));
+    query::distance(&Pose::IDENTITY, &segment(p1, q1), &Pose::IDENTITY, &segment(p2, q2))
+        .expect("segments are supported")
+        .distance
+}
+
+#[test]
+fn segment_distances_match_parry() {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+    let mut point =
+        || v(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+    for k in 0..5000 {
+        let (p1, q1, p2, w) = (point(), point(), point(), point());
+        // Parallel, degenerate, crossing and general second segments.
+        let (p2, q2) = match k % 5 {
+            0 => (p2, p2 + (q1 - p1) * 0.7),
+            1 => (p2, p2),
+            2 => (p1 + (q1 - p1) * 0.3 + w, p1 + (q1 - p1) * 0.3 - w),
+            _ => (p2, w),
+        };
+        let expected = parry_segments(&p1, &q1, &p2, &q2);
+        let found = segment_segment_distance(&p1, &q1, &p2, &q2);
+        assert!((found - expected).abs() < TOL, "{k}: {found} vs {expected}");
+        let on = closest_on_segment(&p1, &q1, &p2);
+        assert!(((on - p2).norm() - parry_segments(&p1, &q1, &p2, &p2)).abs() < TOL);
+    }
+    // A degenerate first segment too.
+    let (p, a, b) = (v(0.0, 0.0, 1.0), v(-1.0, 0.0, 0.0), v(1.0, 0.0, 0.0));
+    assert!((segment_segment_distance(&p, &p, &a, &b) - 1.0).abs() < TOL);
+}
+
+/// Along straight joint motions of one or two joints at random speeds (where the bound is
+/// nearly tight), no point of a capsule's segment travels farther than its `Motion` allows:
+/// from the base for the obstacle pairs, and from the other capsule's frame for the self
+/// pairs.
+#[test]
+fn capsules_move_within_their_motion_bounds() {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(13);
+    for name in ["panda", "coman_right_arm", "centauro_right_arm", "iiwa14", "human_arm"] {
+        let path = format!("{}/../../robots/{name}.urdf", env!("CARGO_MANIFEST_DIR"));
+        let robot = Robot::from_urdf_file(path).expect("robot loads");
+        let model = CollisionModel::new(&robot, &CollisionScene::new(&[]));
+        let (lower, upper) = (robot.lower(), robot.upper());
+        // (capsule, the frame it is seen from, the joints between)
+        let mut cases: Vec<(usize, usize, std::ops::Range<usize>)> =
+            model.moving.iter().map(|&i| (i, 0, 0..model.links[i].frame)).collect();
+        for pair in &model.self_pairs {
+            let other = if pair.distal == pair.link { pair.other } else { pair.link };
+            cases.push((pair.distal, model.links[other].frame, pair.joints.clone()));
+        }
+        let mut tightest: Real = 0.0;
+        for _ in 0..400 {
+            let q = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+            let (j, k) = (rng.random_range(0..DOF), rng.random_range(0..DOF));
+            let mut dq = JointVector::zeros();
+            dq[j] = rng.random_range(-3.0..3.0);
+            dq[k] = rng.random_range(-3.0..3.0);
+            let frames = model.chain.frames(&q);
+            for (i, seen_from, joints) in cases.clone() {
+                let capsule = &model.links[i];
+                let seen = |q: &JointVector| {
+                    let frames = model.chain.frames(q);
+                    let (from, posed) = (&frames[seen_from], capsule.posed(&frames));
+                    let local = |p: Vector3| from.rotation.transpose() * (p - from.translation);
+                    (local(posed.a), local(posed.b))
+                };
+                let posed = capsule.posed(&frames);
+                let motion = Motion::new(&frames, &posed, &capsule.levers, &dq.abs(), joints);
+                let (mut travelled, mut last) = (0.0, seen(&q));
+                for step in 1..=200 {
+                    let s = step as Real / 200.0;
+                    let now = seen(&(q + dq * s));
+                    // The farther travelled of the two ends, bounding every point between.
+                    travelled += (now.0 - last.0).norm().max((now.1 - last.1).norm());
+                    last = now;
+                    let bound = motion.threshold(s);
+                    assert!(travelled <= bound + 1e-9, "{name}: {travelled} > {bound} at {s}");
+                    if bound > 1e-3 {
+                        tightest = tightest.max(travelled / bound);
+                    }
+                }
+            }
+        }
+        assert!(tightest > 0.8, "{name}: the bound is never approached: {tightest}");
+    }
+}
