@@ -136,15 +136,26 @@ fn rrt(c: &mut Criterion) {
         .collect();
     let robot = Robot::from_urdf_file(path("robots/panda.urdf")).expect("robot");
     let options = RrtOptions::default();
-    let mut checks = 0;
-    let started = std::time::Instant::now();
-    for scene in &scenes {
-        let found = rrt_connect(&robot, scene, &start, &[goal], &options).expect("a path");
-        checks += found.stats.collision_checks;
+    // Each instance alone, a few rounds: the median per instance and the check rate.
+    let (mut times, mut checks, mut total) = (Vec::new(), Vec::new(), 0.0);
+    for _ in 0..20 {
+        for scene in &scenes {
+            let started = std::time::Instant::now();
+            let found = rrt_connect(&robot, scene, &start, &[goal], &options).expect("a path");
+            let time = started.elapsed().as_secs_f64();
+            times.push(time);
+            total += time;
+            checks.push(found.stats.collision_checks);
+        }
     }
+    times.sort_by(Real::total_cmp);
+    checks.sort_unstable();
     eprintln!(
-        "rrt/panda_sphere_cage: {checks} collision checks in 10 instances, {:.0} checks/s",
-        checks as Real / started.elapsed().as_secs_f64()
+        "rrt/panda_sphere_cage: median {:.3} ms and {} collision checks per instance, {:.0} \
+         checks/s",
+        times[times.len() / 2] * 1e3,
+        checks[checks.len() / 2],
+        checks.iter().sum::<usize>() as Real / total
     );
     let mut group = c.benchmark_group("rrt");
     group.sample_size(10);

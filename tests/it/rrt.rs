@@ -2,10 +2,11 @@
 //! motion between checks), limits, determinism per seed, and clear failures.
 
 use a2ml::Robot;
-use a2ml::collision::{CollisionScene, min_distance};
+use a2ml::collision::{CollisionScene, arm_capsules, min_distance};
 use a2ml::kinematics::arm_pose;
 use a2ml::language::{Obstacle, Shape};
 use a2ml::math::{JointVector, Real, Vector3};
+use a2ml::robot::LinkRole;
 use a2ml::solve::rrt::{RrtError, RrtOptions, RrtPath, rrt_connect, time_parameterise};
 
 use crate::common;
@@ -13,6 +14,12 @@ use crate::common;
 /// The Panda caged by 14 spheres (../shared/bench/panda_sphere_cage.json, instance `k`), in
 /// {b}: the file's frame is the URDF root, S is 0.333 m above it.
 fn sphere_cage(k: usize) -> (JointVector, JointVector, CollisionScene) {
+    let (start, goal, spheres) = cage_spheres(k);
+    (start, goal, CollisionScene::new(&spheres))
+}
+
+/// The start, goal and spheres of [`sphere_cage`].
+fn cage_spheres(k: usize) -> (JointVector, JointVector, Vec<Obstacle>) {
     let path = format!("{}/../shared/bench/panda_sphere_cage.json", env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(&path).expect("the shared benchmark file is beside");
     let data: serde_json::Value = serde_json::from_str(&text).expect("json");
@@ -34,7 +41,7 @@ fn sphere_cage(k: usize) -> (JointVector, JointVector, CollisionScene) {
             }
         })
         .collect();
-    (q("start"), q("goal"), CollisionScene::new(&obstacles))
+    (q("start"), q("goal"), obstacles)
 }
 
 /// Every edge at points no more than 1 mm of arm motion apart (bounded by 1.5 m of lever per
@@ -114,6 +121,37 @@ fn invalid_ends_and_exhausted_searches_are_reported() {
         rrt_connect(&robot, &scene, &start, &[goal], &RrtOptions { step: 0.0, ..options }),
         Err(RrtError::InvalidOptions { .. })
     ));
+}
+
+/// The velocity QP leaves the arm at the safety distance (the clearance) from an obstacle:
+/// such a start, and such a goal, must be planned from and to.
+#[test]
+fn an_end_just_beyond_the_clearance_is_planned_from_and_to() {
+    let robot = common::load("panda");
+    let options = RrtOptions::default();
+    let (start, goal, cage) = cage_spheres(0);
+    let pose = arm_pose(&robot, &start);
+    let hand = arm_capsules(&robot, &pose)
+        .into_iter()
+        .find(|c| c.role == LinkRole::Hand)
+        .expect("the Panda has a hand capsule");
+    let side = (hand.b - hand.a).cross(&Vector3::z()).normalize();
+    // A ball beside the hand at the start, 1 mm and 0.1 mm beyond the clearance: less than the
+    // clearance plus the resolution, which every check used to ask for.
+    for slack in [1e-3, 1e-4] {
+        let (radius, gap) = (0.03, options.clearance + slack);
+        let center = 0.5 * (hand.a + hand.b) + side * (hand.radius + gap + radius);
+        let ball = Obstacle { name: "beside".into(), shape: Shape::Sphere { center, radius } };
+        let scene = CollisionScene::new(&[cage.clone(), vec![ball]].concat());
+        let (d, _, obstacle) = min_distance(&robot, &pose, &scene).expect("pairs");
+        assert!((d - gap).abs() < 1e-9 && obstacle == "beside", "{d} from {obstacle}");
+        assert!(gap < options.clearance + options.resolution);
+        for (from, to) in [(start, goal), (goal, start)] {
+            let path = rrt_connect(&robot, &scene, &from, &[to], &options).expect("a path");
+            assert_eq!((path.waypoints.first(), path.waypoints.last()), (Some(&from), Some(&to)));
+            assert_collision_free(&robot, &scene, &path, options.clearance);
+        }
+    }
 }
 
 #[test]

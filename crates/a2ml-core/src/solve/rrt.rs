@@ -3,18 +3,20 @@
 //!
 //! Two trees grow towards uniform samples within the joint limits, one from the start and one
 //! from the goal configurations, each extension straight in joint space by at most
-//! [`RrtOptions::step`] and greedily connected to the other tree. Edges are checked at
-//! steps bounded by the clearance found at the last check (half of it, minus the clearance
-//! kept, of arm-point motion), and every check asks for `clearance + resolution`, so the whole
-//! edge keeps `clearance`. The path is then shortcut. Seeded: the same seed gives the same
-//! path.
+//! [`RrtOptions::step`] and greedily connected to the other tree. An edge is covered by checks
+//! that each tell how far either way the arm keeps the clearance
+//! ([`crate::collision::advancement`]), so the whole edge keeps `clearance`; the start and the
+//! goals need only keep it themselves. The path is then shortcut. Seeded: the same seed gives
+//! the same path.
 
 use std::time::Instant;
 
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 
-use crate::collision::{CollisionScene, min_distance};
+use crate::collision::{
+    CollisionModel, CollisionScene, advancement, clearance, min_distance, motion_bound,
+};
 use crate::kinematics::arm_pose;
 use crate::math::{JointVector, Real};
 use crate::profile::{BellProfile, JointSample};
@@ -26,10 +28,12 @@ use crate::trajectory::{Trajectory, TrajectoryError, sample_times};
 pub struct RrtOptions {
     /// Seed of the sampler.
     pub seed: u64,
-    /// Largest joint-space extension per step (rad, Euclidean norm), default 0.3.
+    /// Largest joint-space extension per step (rad, Euclidean norm), default 2: long edges
+    /// are cheap to check where the arm is clear, and fewer nodes connect sooner.
     pub step: Real,
-    /// Margin beyond the clearance that every check asks for (m), default 5 mm: checks along
-    /// an edge are never closer than half of it in arm-point motion.
+    /// Arm motion (m) over which a check along an edge must show the clearance kept, either
+    /// way, default 5 mm: half of it at least, so checks are never closer than half of it,
+    /// except next to a start or goal itself closer to the clearance than that.
     pub resolution: Real,
     /// Distance kept from obstacles and between non-adjacent links (m), default 0.01.
     pub clearance: Real,
@@ -45,7 +49,7 @@ impl Default for RrtOptions {
     fn default() -> Self {
         Self {
             seed: 0,
-            step: 0.3,
+            step: 2.0,
             resolution: 0.005,
             clearance: 0.01,
             max_samples: 20_000,
@@ -150,7 +154,7 @@ pub fn rrt_connect(
     let mut swapped = false;
     // An edge straight from the start to a goal needs no tree.
     for &(index, g) in &valid_goals {
-        if space.edge_free(start, &g) {
+        if space.edge_free(start, &g, false) {
             let stats = space.stats(1, 0, started);
             return Ok(RrtPath { waypoints: vec![*start, g], goal: index, stats });
         }
@@ -213,34 +217,29 @@ struct Space<'a> {
     robot: &'a Robot,
     scene: &'a CollisionScene,
     options: &'a RrtOptions,
-    /// Per joint, how far any capsule point it moves can be from its axis (m): a point moves
-    /// at most Σ levers_i |Δq_i| along a straight joint-space edge.
-    levers: JointVector,
+    model: CollisionModel,
+    /// Uncovered stretches of the edge being checked (reused, to allocate once).
+    gaps: Vec<Gap>,
     checks: usize,
+}
+
+/// A stretch (from, to) of an edge's parameter not yet known to keep the clearance, and whether
+/// it reaches an end of the edge that keeps the clearance by less than the resolution.
+#[derive(Debug, Clone, Copy)]
+struct Gap {
+    from: Real,
+    to: Real,
+    tight_a: bool,
+    tight_b: bool,
 }
 
 impl<'a> Space<'a> {
     fn new(robot: &'a Robot, scene: &'a CollisionScene, options: &'a RrtOptions) -> Self {
-        // Joint j turns frames j+1..7; its axis passes through the origin of frame j+1. A
-        // capsule point on frame f is within Σ_{k=j+1}^{f-1} |t_k| (the joint offsets between)
-        // plus its own distance from frame f's origin of that axis.
-        let offsets: Vec<Real> =
-            robot.joints.iter().map(|j| j.parent_from_joint.translation.vector.norm()).collect();
-        let levers = JointVector::from_fn(|j, _| {
-            robot
-                .capsules
-                .iter()
-                .filter(|c| c.frame > j)
-                .map(|c| {
-                    let between: Real = offsets[j + 1..c.frame].iter().sum();
-                    between + c.a.norm().max(c.b.norm()) + c.radius
-                })
-                .fold(0.0, Real::max)
-        });
-        Self { robot, scene, options, levers, checks: 0 }
+        let model = CollisionModel::new(robot, scene);
+        Self { robot, scene, options, model, gaps: Vec::new(), checks: 0 }
     }
 
-    /// Why `q` is not a valid configuration, if it is not.
+    /// Why `q` is not a valid end (within the limits, `clearance` from the scene), if it is not.
     fn invalid(&mut self, q: &JointVector) -> Option<String> {
         if let Some((i, v)) = self.robot.limit_violation(q, 0.0) {
             return Some(format!(
@@ -249,44 +248,74 @@ impl<'a> Space<'a> {
             ));
         }
         self.checks += 1;
-        let pose = arm_pose(self.robot, q);
-        match min_distance(self.robot, &pose, self.scene) {
-            Some((d, link, obstacle)) if d < self.options.clearance + self.options.resolution => {
-                Some(format!("{:.1} mm from `{obstacle}` (link `{link}`)", d * 1e3))
-            }
-            _ => None,
+        if clearance(&self.model, q) >= self.options.clearance {
+            return None;
         }
+        let (d, link, obstacle) = min_distance(self.robot, &arm_pose(self.robot, q), self.scene)?;
+        Some(format!("{:.1} mm from `{obstacle}` (link `{link}`)", d * 1e3))
     }
 
-    /// The smallest distance of the arm at `q` from the scene and from itself (∞ with no
-    /// pair).
-    fn clearance_at(&mut self, q: &JointVector) -> Real {
+    /// How far (in units of `dq`) the arm at `q` may move along `dq`, either way, keeping the
+    /// clearance: negative where it is not kept.
+    fn advancement(&mut self, q: &JointVector, dq: &JointVector) -> Real {
         self.checks += 1;
-        let pose = arm_pose(self.robot, q);
-        min_distance(self.robot, &pose, self.scene).map_or(Real::INFINITY, |(d, ..)| d)
+        advancement(&self.model, q, dq, self.options.clearance)
     }
 
-    /// Whether the straight edge a -> b keeps the clearance. No arm point moves more than
-    /// travel = Σ lever_i |Δq_i| along the whole edge, and two bodies approach at most twice
-    /// as fast as one point moves, so from a check at distance d the next check may wait
-    /// until the points have moved (d - clearance) / 2: the edge keeps the clearance between
-    /// checks, and every check asks for clearance + resolution, so checks are never closer
-    /// than half the resolution of arm motion.
-    fn edge_free(&mut self, a: &JointVector, b: &JointVector) -> bool {
-        let travel = self.levers.dot(&(b - a).abs());
-        let (clearance, needed) =
-            (self.options.clearance, self.options.clearance + self.options.resolution);
-        let mut tau: Real = 0.0;
-        loop {
-            let d = self.clearance_at(&(a + (b - a) * tau));
-            if d < needed {
+    /// Whether the straight edge a -> b keeps the clearance, `b` being a new configuration
+    /// (checked first, as the likelier to collide) or a node.
+    ///
+    /// A check at a point of the edge tells how far either way along it the arm keeps the
+    /// clearance ([`advancement`]), so the edge is covered by checks placed in the middle of
+    /// what is still uncovered. Each check must show the clearance kept over half the
+    /// resolution of arm motion either way, or over the rest of its stretch, or lie in a
+    /// stretch reaching an end that shows less (a start left near the clearance: such
+    /// stretches are split finer until covered, down to a millionth of that). The ends must
+    /// keep the clearance, a new `b` over half the resolution too, so that the edges leaving it
+    /// are not that fine. So the whole edge keeps `clearance`.
+    fn edge_free(&mut self, a: &JointVector, b: &JointVector, new: bool) -> bool {
+        let dq = b - a;
+        let travel = motion_bound(&self.model, &dq);
+        if travel == 0.0 {
+            return true;
+        }
+        // Half the resolution of arm motion, in units of the edge.
+        let floor = 0.5 * self.options.resolution / travel;
+        let at_b = self.advancement(b, &dq);
+        if at_b < if new { floor } else { 0.0 } {
+            return false;
+        }
+        let at_a = self.advancement(a, &dq);
+        if at_a < 0.0 {
+            return false;
+        }
+        // Next to a tight end, stretches are split until covered, down to this.
+        let finest = floor * 1e-6;
+        self.gaps.clear();
+        self.gaps.push(Gap {
+            from: at_a,
+            to: 1.0 - at_b,
+            tight_a: at_a < floor,
+            tight_b: at_b < floor,
+        });
+        while let Some(gap) = self.gaps.pop() {
+            if gap.from >= gap.to {
+                continue;
+            }
+            let (middle, half) = (0.5 * (gap.from + gap.to), 0.5 * (gap.to - gap.from));
+            let covered = self.advancement(&(a + dq * middle), &dq);
+            if covered >= half {
+                continue;
+            }
+            let near_tight_end = gap.tight_a || gap.tight_b;
+            if covered < 0.0 || (covered < floor && !(near_tight_end && half > finest)) {
                 return false;
             }
-            if tau >= 1.0 || travel == 0.0 {
-                return true;
-            }
-            tau = (tau + 0.5 * (d - clearance) / travel).min(1.0);
+            // Towards b last: a stretch next to a tends to be checked first.
+            self.gaps.push(Gap { from: middle + covered, tight_a: false, ..gap });
+            self.gaps.push(Gap { to: middle - covered, tight_b: false, ..gap });
         }
+        true
     }
 
     fn stats(&self, samples: usize, nodes: usize, started: Instant) -> RrtStats {
@@ -332,8 +361,9 @@ impl Tree {
         best.0
     }
 
-    /// One step from the nearest node towards `target`.
-    fn step(&mut self, target: &JointVector, space: &mut Space) -> Extension {
+    /// One step from the nearest node towards `target`, a new configuration or a node of the
+    /// other tree.
+    fn step(&mut self, target: &JointVector, new_target: bool, space: &mut Space) -> Extension {
         let near = self.nearest(target);
         let from = self.nodes[near].q;
         let delta = target - from;
@@ -343,7 +373,7 @@ impl Tree {
         } else {
             (from + delta * (space.options.step / distance), false)
         };
-        if !space.edge_free(&from, &to) {
+        if !space.edge_free(&from, &to, new_target || !reached) {
             return Extension::Trapped;
         }
         self.nodes.push(Node { q: to, parent: Some(near), goal: None });
@@ -352,7 +382,7 @@ impl Tree {
     }
 
     fn extend(&mut self, target: &JointVector, space: &mut Space) -> Option<usize> {
-        match self.step(target, space) {
+        match self.step(target, true, space) {
             Extension::Reached(i) | Extension::Advanced(i) => Some(i),
             Extension::Trapped => None,
         }
@@ -361,7 +391,7 @@ impl Tree {
     /// Steps towards `target` until it is reached (its node) or blocked.
     fn connect(&mut self, target: &JointVector, space: &mut Space) -> Option<usize> {
         loop {
-            match self.step(target, space) {
+            match self.step(target, false, space) {
                 Extension::Reached(i) => return Some(i),
                 Extension::Advanced(_) => continue,
                 Extension::Trapped => return None,
@@ -387,21 +417,31 @@ impl Tree {
     }
 }
 
-/// Random shortcuts: two points on the path joined straight when the edge is free.
+/// Random shortcuts: two waypoints joined straight when the edge is free. A pair found blocked
+/// is not checked again until the path changes (the answer would be the same), and the search
+/// ends once every pair is.
 fn shortcut(
     mut path: Vec<JointVector>,
     space: &mut Space,
     rng: &mut StdRng,
     attempts: usize,
 ) -> Vec<JointVector> {
+    let mut blocked: Vec<(usize, usize)> = Vec::new();
     for _ in 0..attempts {
-        if path.len() < 3 {
+        let n = path.len();
+        if n < 3 || blocked.len() == (n - 1) * (n - 2) / 2 {
             break;
         }
-        let i = rng.random_range(0..path.len() - 2);
-        let j = rng.random_range(i + 2..path.len());
-        if space.edge_free(&path[i], &path[j]) {
+        let i = rng.random_range(0..n - 2);
+        let j = rng.random_range(i + 2..n);
+        if blocked.contains(&(i, j)) {
+            continue;
+        }
+        if space.edge_free(&path[i], &path[j], false) {
             path.drain(i + 1..j);
+            blocked.clear();
+        } else {
+            blocked.push((i, j));
         }
     }
     path
