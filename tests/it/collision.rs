@@ -205,6 +205,7 @@ fn the_collision_model_agrees_with_min_distance() {
 fn advancement_keeps_the_clearance_either_way() {
     for (name, robot) in all_robots() {
         let mut rng = rng(29);
+        let mut moved = 0;
         for _ in 0..200 {
             let scene = CollisionScene::new(&random_scene(&mut rng));
             let model = CollisionModel::new(&robot, &scene);
@@ -212,6 +213,10 @@ fn advancement_keeps_the_clearance_either_way() {
             let dq = random_q(&robot, &mut rng) - q;
             let kept = rng.random_range(0.0..0.05);
             let s = advancement(&model, &q, &dq, kept);
+            for least in [-1.0, 0.0, 0.5 * s, s, 2.0 * s, rng.random_range(0.0..0.2)] {
+                let expected = (s >= least).then_some(s);
+                assert_eq!(advancement_at_least(&model, &q, &dq, kept, least), expected);
+            }
             let d = |q| {
                 min_distance(&robot, &arm_pose(&robot, &q), &scene).map_or(Real::INFINITY, |m| m.0)
             };
@@ -219,10 +224,12 @@ fn advancement_keeps_the_clearance_either_way() {
             if s <= 0.0 || !s.is_finite() {
                 continue;
             }
+            moved += 1;
             for k in -20..=20 {
                 let t = s * k as Real / 20.0;
                 assert!(d(q + dq * t) >= kept - TOL, "{name}: at {t} of {s}");
             }
         }
+        assert!(moved > 50, "{name}: too few configurations clear to move from: {moved}");
     }
 }

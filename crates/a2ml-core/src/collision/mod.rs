@@ -3,9 +3,10 @@
 //!
 //! Entry points: [`CollisionScene::new`], [`arm_capsules`], [`distances`],
 //! [`min_distance`]; for many configurations of one scene (sampling
-//! planners), [`CollisionModel`] with [`clearance`], [`advancement`] and
-//! [`motion_bound`]. Everything is in {b}, SI units. parry enters the crate
-//! here only; its glam types never leave this module.
+//! planners), [`CollisionModel`] with [`clearance`], [`advancement`] (and
+//! [`advancement_at_least`]) and [`motion_bound`]. Everything is in {b}, SI
+//! units. parry enters the crate here only; its glam types never leave this
+//! module.
 
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query::{self, Contact};
@@ -18,7 +19,7 @@ use crate::robot::{LinkRole, Robot};
 
 mod model;
 
-pub use model::{CollisionModel, advancement, clearance, motion_bound};
+pub use model::{CollisionModel, advancement, advancement_at_least, clearance, motion_bound};
 
 /// The task's obstacles as parry shapes, positioned in {b}.
 ///

@@ -52,6 +52,8 @@ struct SelfPair {
     /// The joints between the two frames: only they move one capsule relative to the other
     /// (the joints before both move them as one).
     joints: std::ops::Range<usize>,
+    /// The distal capsule's levers for those joints, zero for the others.
+    levers: JointVector,
 }
 
 #[derive(Debug, Clone)]
@@ -95,7 +97,11 @@ impl CollisionModel {
             .map(|(link, other)| {
                 let (f, g) = (links[link].frame, links[other].frame);
                 let distal = if f >= g { link } else { other };
-                SelfPair { link, other, distal, joints: f.min(g)..f.max(g) }
+                let joints = f.min(g)..f.max(g);
+                let levers = JointVector::from_fn(|j, _| {
+                    if joints.contains(&j) { links[distal].levers[j] } else { 0.0 }
+                });
+                SelfPair { link, other, distal, joints, levers }
             })
             .collect();
         let (mut spheres, mut capsules, mut convex) = (Vec::new(), Vec::new(), Vec::new());
@@ -121,7 +127,7 @@ impl CollisionModel {
 /// The smallest signed distance (m, negative for a penetration) over the pairs of
 /// [`super::min_distance`] with the arm at `q`; ∞ when there is no pair.
 pub fn clearance(model: &CollisionModel, q: &JointVector) -> Real {
-    model.smallest(q, 0.0, None)
+    model.smallest(q, 0.0, None, Real::NEG_INFINITY)
 }
 
 /// How far the arm at `q` can move along the straight joint-space motion `dq`, either way,
@@ -142,7 +148,20 @@ pub fn advancement(
     dq: &JointVector,
     clearance: Real,
 ) -> Real {
-    model.smallest(q, clearance, Some(&dq.abs()))
+    model.smallest(q, clearance, Some(&dq.abs()), Real::NEG_INFINITY)
+}
+
+/// [`advancement`] if it is at least `least`, else `None`: a check that only needs to know
+/// whether the arm can move that far stops at the first pair that says no.
+pub fn advancement_at_least(
+    model: &CollisionModel,
+    q: &JointVector,
+    dq: &JointVector,
+    clearance: Real,
+    least: Real,
+) -> Option<Real> {
+    let found = model.smallest(q, clearance, Some(&dq.abs()), least);
+    (found >= least).then_some(found)
 }
 
 /// The farthest any point of the arm's capsule segments moves along the straight joint-space
@@ -156,31 +175,35 @@ impl CollisionModel {
     /// The smallest `reach(d − offset)` over the pairs, d the signed distance of a pair and
     /// `reach` the advancement its [`Motion`] along `speed` (|dq|) allows; with no motion,
     /// the smallest d − offset.
-    fn smallest(&self, q: &JointVector, offset: Real, speed: Option<&JointVector>) -> Real {
+    fn smallest(
+        &self,
+        q: &JointVector,
+        offset: Real,
+        speed: Option<&JointVector>,
+        least: Real,
+    ) -> Real {
         let frames = self.chain.frames(q);
-        let motion = |link: &Posed, mover: &LinkCapsule, joints: std::ops::Range<usize>| {
-            speed.map_or(Motion::UNIT, |speed| {
-                Motion::new(&frames, link, &mover.levers, speed, joints)
-            })
+        // The configuration-independent motion bound first: cheap, and never below the
+        // configuration's own, so it tells which pairs cannot lower `best`; the
+        // configuration's own only for the nearest obstacle of a capsule that may.
+        let loose =
+            |levers: &JointVector| speed.map_or(Motion::UNIT, |s| Motion::at_most(levers.dot(s)));
+        let exact = |link: &Posed, levers: &JointVector, joints: std::ops::Range<usize>| {
+            speed.map_or(Motion::UNIT, |speed| Motion::new(&frames, link, levers, speed, joints))
         };
         let mut best = Real::INFINITY;
         for &i in &self.moving {
             let capsule = &self.links[i];
             let link = capsule.posed(&frames);
-            let motion = motion(&link, capsule, 0..capsule.frame);
-            // Only distances (between the segment and an obstacle's core) below this can
-            // lower `best`.
-            let mut below = offset + motion.threshold(best) + link.radius;
-            let take = |distance: Real, best: &mut Real, below: &mut Real| {
-                *best = best.min(motion.reach(distance - link.radius - offset));
-                *below = offset + motion.threshold(*best) + link.radius;
-            };
+            // Only distances (between the segment and an obstacle's core) below this may lower
+            // `best`; it falls to the nearest found.
+            let mut below = offset + loose(&capsule.levers).threshold(best) + link.radius;
             for sphere in &self.spheres {
                 let reach = below + sphere.radius;
                 if reach > 0.0 {
                     let squared = link.squared_distance_to_point(&sphere.center);
                     if squared < reach * reach {
-                        take(squared.sqrt() - sphere.radius, &mut best, &mut below);
+                        below = squared.sqrt() - sphere.radius;
                     }
                 }
             }
@@ -190,7 +213,7 @@ impl CollisionModel {
                     let distance =
                         segment_segment_distance(&link.a, &link.b, &capsule.a, &capsule.b);
                     if distance < reach {
-                        take(distance - capsule.radius, &mut best, &mut below);
+                        below = distance - capsule.radius;
                     }
                 }
             }
@@ -198,19 +221,29 @@ impl CollisionModel {
                 let gap = (link.center - body.center).norm() - link.bound - body.bound;
                 if gap < below - link.radius {
                     if let Some(distance) = link.convex_distance(body, below) {
-                        take(distance, &mut best, &mut below);
+                        below = below.min(distance);
                     }
+                }
+            }
+            let slack = below - link.radius - offset;
+            if loose(&capsule.levers).reach(slack) < best {
+                best = best.min(exact(&link, &capsule.levers, 0..capsule.frame).reach(slack));
+                if best < least {
+                    return best;
                 }
             }
         }
         for pair in &self.self_pairs {
             let (link, other) =
                 (self.links[pair.link].posed(&frames), self.links[pair.other].posed(&frames));
-            let mover = &self.links[pair.distal];
             let moved = if pair.distal == pair.link { &link } else { &other };
-            let motion = motion(moved, mover, pair.joints.clone());
-            if link.gap_bound(&other) - offset < motion.threshold(best) {
-                best = best.min(motion.reach(link.distance(&other) - offset));
+            let loose = loose(&pair.levers);
+            if link.gap_bound(&other) - offset < loose.threshold(best) {
+                let slack = link.distance(&other) - offset;
+                if loose.reach(slack) < best {
+                    let exact = exact(moved, &pair.levers, pair.joints.clone());
+                    best = best.min(exact.reach(slack));
+                }
             }
         }
         best
@@ -228,7 +261,12 @@ struct Motion {
 
 impl Motion {
     /// The distance itself: s is in metres.
-    const UNIT: Self = Self { bound: 1.0, linear: 1.0, quadratic: 0.0 };
+    const UNIT: Self = Self::at_most(1.0);
+
+    /// Never more than `rate` per unit of s.
+    const fn at_most(rate: Real) -> Self {
+        Self { bound: rate, linear: rate, quadratic: 0.0 }
+    }
 
     /// The motion of the segment `link` (posed at `frames`, with `levers` bounding its
     /// distances from the joint axes) by the `joints` given, at joint speeds `speed` (|dq|).
@@ -401,6 +439,9 @@ struct Posed {
     a: Vector3,
     b: Vector3,
     radius: Real,
+    /// b − a, and the inverse of its squared length (0 for a point).
+    along: Vector3,
+    inverse_squared_length: Real,
     center: Vector3,
     bound: Real,
 }
@@ -414,7 +455,21 @@ impl LinkCapsule {
 
 impl Posed {
     fn new(a: Vector3, b: Vector3, radius: Real) -> Self {
-        Self { a, b, radius, center: 0.5 * (a + b), bound: 0.5 * (b - a).norm() + radius }
+        let along = b - a;
+        let squared_length = along.norm_squared();
+        Self {
+            a,
+            b,
+            radius,
+            along,
+            inverse_squared_length: if squared_length > Real::MIN_POSITIVE {
+                1.0 / squared_length
+            } else {
+                0.0
+            },
+            center: 0.5 * (a + b),
+            bound: 0.5 * squared_length.sqrt() + radius,
+        }
     }
 
     /// A lower bound of the distance to `other` from the bounding spheres.
@@ -426,12 +481,12 @@ impl Posed {
     fn distance(&self, other: &Posed) -> Real {
         segment_segment_distance(&self.a, &self.b, &other.a, &other.b) - self.radius - other.radius
     }
-}
 
-impl Posed {
     /// The squared distance from the segment to `p`.
     fn squared_distance_to_point(&self, p: &Vector3) -> Real {
-        (closest_on_segment(&self.a, &self.b, p) - p).norm_squared()
+        let from_a = p - self.a;
+        let t = (from_a.dot(&self.along) * self.inverse_squared_length).clamp(0.0, 1.0);
+        (from_a - self.along * t).norm_squared()
     }
 
     /// The distance from the segment to a parry body, if below `below`.
@@ -446,16 +501,6 @@ impl Posed {
         // Every pair of shapes here is supported by parry's default dispatcher.
         contact.ok().flatten().map(|c| c.dist)
     }
-}
-
-/// The closest point of the segment a–b to `p`.
-fn closest_on_segment(a: &Vector3, b: &Vector3, p: &Vector3) -> Vector3 {
-    let ab = b - a;
-    let length2 = ab.norm_squared();
-    if length2 <= Real::MIN_POSITIVE {
-        return *a;
-    }
-    a + ab * ((p - a).dot(&ab) / length2).clamp(0.0, 1.0)
 }
 
 /// Distance between the segments p1–q1 and p2–q2 (Ericson, Real-Time Collision Detection

@@ -37,8 +37,8 @@ fn segment_distances_match_parry() {
         let expected = parry_segments(&p1, &q1, &p2, &q2);
         let found = segment_segment_distance(&p1, &q1, &p2, &q2);
         assert!((found - expected).abs() < TOL, "{k}: {found} vs {expected}");
-        let on = closest_on_segment(&p1, &q1, &p2);
-        assert!(((on - p2).norm() - parry_segments(&p1, &q1, &p2, &p2)).abs() < TOL);
+        let squared = Posed::new(p1, q1, 0.0).squared_distance_to_point(&p2);
+        assert!((squared.sqrt() - parry_segments(&p1, &q1, &p2, &p2)).abs() < TOL);
     }
     // A degenerate first segment too.
     let (p, a, b) = (v(0.0, 0.0, 1.0), v(-1.0, 0.0, 0.0), v(1.0, 0.0, 0.0));
@@ -57,12 +57,16 @@ fn capsules_move_within_their_motion_bounds() {
         let robot = Robot::from_urdf_file(path).expect("robot loads");
         let model = CollisionModel::new(&robot, &CollisionScene::new(&[]));
         let (lower, upper) = (robot.lower(), robot.upper());
-        // (capsule, the frame it is seen from, the joints between)
-        let mut cases: Vec<(usize, usize, std::ops::Range<usize>)> =
-            model.moving.iter().map(|&i| (i, 0, 0..model.links[i].frame)).collect();
+        // (capsule, the frame it is seen from, its levers, the joints between)
+        let mut cases: Vec<(usize, usize, JointVector, std::ops::Range<usize>)> = model
+            .moving
+            .iter()
+            .map(|&i| (i, 0, model.links[i].levers, 0..model.links[i].frame))
+            .collect();
         for pair in &model.self_pairs {
             let other = if pair.distal == pair.link { pair.other } else { pair.link };
-            cases.push((pair.distal, model.links[other].frame, pair.joints.clone()));
+            let seen_from = model.links[other].frame;
+            cases.push((pair.distal, seen_from, pair.levers, pair.joints.clone()));
         }
         let mut tightest: Real = 0.0;
         for _ in 0..400 {
@@ -72,7 +76,7 @@ fn capsules_move_within_their_motion_bounds() {
             dq[j] = rng.random_range(-3.0..3.0);
             dq[k] = rng.random_range(-3.0..3.0);
             let frames = model.chain.frames(&q);
-            for (i, seen_from, joints) in cases.clone() {
+            for (i, seen_from, levers, joints) in cases.clone() {
                 let capsule = &model.links[i];
                 let seen = |q: &JointVector| {
                     let frames = model.chain.frames(q);
@@ -81,7 +85,7 @@ fn capsules_move_within_their_motion_bounds() {
                     (local(posed.a), local(posed.b))
                 };
                 let posed = capsule.posed(&frames);
-                let motion = Motion::new(&frames, &posed, &capsule.levers, &dq.abs(), joints);
+                let motion = Motion::new(&frames, &posed, &levers, &dq.abs(), joints);
                 let (mut travelled, mut last) = (0.0, seen(&q));
                 for step in 1..=200 {
                     let s = step as Real / 200.0;
