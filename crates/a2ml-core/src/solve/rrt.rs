@@ -15,7 +15,7 @@ use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 
 use crate::collision::{
-    CollisionModel, CollisionScene, advancement, clearance, min_distance, motion_bound,
+    CollisionModel, CollisionScene, advancement_at_least, clearance, min_distance, motion_bound,
 };
 use crate::kinematics::arm_pose;
 use crate::math::{JointVector, Real};
@@ -256,10 +256,10 @@ impl<'a> Space<'a> {
     }
 
     /// How far (in units of `dq`) the arm at `q` may move along `dq`, either way, keeping the
-    /// clearance: negative where it is not kept.
-    fn advancement(&mut self, q: &JointVector, dq: &JointVector) -> Real {
+    /// clearance, if at least `least`.
+    fn advancement(&mut self, q: &JointVector, dq: &JointVector, least: Real) -> Option<Real> {
         self.checks += 1;
-        advancement(&self.model, q, dq, self.options.clearance)
+        advancement_at_least(&self.model, q, dq, self.options.clearance, least)
     }
 
     /// Whether the straight edge a -> b keeps the clearance, `b` being a new configuration
@@ -281,14 +281,12 @@ impl<'a> Space<'a> {
         }
         // Half the resolution of arm motion, in units of the edge.
         let floor = 0.5 * self.options.resolution / travel;
-        let at_b = self.advancement(b, &dq);
-        if at_b < if new { floor } else { 0.0 } {
+        let Some(at_b) = self.advancement(b, &dq, if new { floor } else { 0.0 }) else {
             return false;
-        }
-        let at_a = self.advancement(a, &dq);
-        if at_a < 0.0 {
+        };
+        let Some(at_a) = self.advancement(a, &dq, 0.0) else {
             return false;
-        }
+        };
         // Next to a tight end, stretches are split until covered, down to this.
         let finest = floor * 1e-6;
         self.gaps.clear();
@@ -303,13 +301,13 @@ impl<'a> Space<'a> {
                 continue;
             }
             let (middle, half) = (0.5 * (gap.from + gap.to), 0.5 * (gap.to - gap.from));
-            let covered = self.advancement(&(a + dq * middle), &dq);
+            // Enough to close the stretch, or to split it.
+            let splits = if (gap.tight_a || gap.tight_b) && half > finest { 0.0 } else { floor };
+            let Some(covered) = self.advancement(&(a + dq * middle), &dq, half.min(splits)) else {
+                return false;
+            };
             if covered >= half {
                 continue;
-            }
-            let near_tight_end = gap.tight_a || gap.tight_b;
-            if covered < 0.0 || (covered < floor && !(near_tight_end && half > finest)) {
-                return false;
             }
             // Towards b last: a stretch next to a tends to be checked first.
             self.gaps.push(Gap { from: middle + covered, tight_a: false, ..gap });
