@@ -31,9 +31,10 @@ pub struct RrtOptions {
     /// Largest joint-space extension per step (rad, Euclidean norm), default 2: long edges
     /// are cheap to check where the arm is clear, and fewer nodes connect sooner.
     pub step: Real,
-    /// Arm motion (m) over which a check along an edge must show the clearance kept, either
-    /// way, default 5 mm: half of it at least, so checks are never closer than half of it,
-    /// except next to a start or goal itself closer to the clearance than that.
+    /// Resolution of the edge checks (m of arm motion), default 5 mm: a check along an edge
+    /// must show the clearance kept over half of it either way (or over the rest of the
+    /// stretch it closes), so checks are never closer than that, except next to a start or goal
+    /// that itself shows less.
     pub resolution: Real,
     /// Distance kept from obstacles and between non-adjacent links (m), default 0.01.
     pub clearance: Real,
@@ -224,7 +225,8 @@ struct Space<'a> {
 }
 
 /// A stretch (from, to) of an edge's parameter not yet known to keep the clearance, and whether
-/// it reaches an end of the edge that keeps the clearance by less than the resolution.
+/// it reaches an end whose own check shows the clearance kept over less than half the
+/// resolution (a tight end).
 #[derive(Debug, Clone, Copy)]
 struct Gap {
     from: Real,
