@@ -187,14 +187,21 @@ impl PositionReference {
 
     /// Pw (m) and its velocity (m/s) at t (s), both in {b}; t is clamped to [0, T].
     pub fn sample(&self, t: Real) -> (Vector3, Vector3) {
-        let (s, speed) = (self.bell.progress(t), self.bell.speed(t));
+        let (p, speed) = (self.at_distance(self.bell.progress(t)), self.bell.speed(t));
         match self.path {
-            PositionPath::Hold => (self.start, Vector3::zeros()),
-            PositionPath::Line { direction } => (self.start + direction * s, direction * speed),
-            PositionPath::About { axis } => {
-                let p = rotation_about(&axis, s) * self.start;
-                (p, axis.cross(&p) * speed)
-            }
+            PositionPath::Hold => (p, Vector3::zeros()),
+            PositionPath::Line { direction } => (p, direction * speed),
+            PositionPath::About { axis } => (p, axis.cross(&p) * speed),
+        }
+    }
+
+    /// Pw (m, {b}) at distance `s` along the path (m for a line, rad for a rotation), not
+    /// limited to the bell's distance: a line goes on past its end.
+    pub fn at_distance(&self, s: Real) -> Vector3 {
+        match self.path {
+            PositionPath::Hold => self.start,
+            PositionPath::Line { direction } => self.start + direction * s,
+            PositionPath::About { axis } => rotation_about(&axis, s) * self.start,
         }
     }
 }
@@ -297,12 +304,20 @@ impl RotationReference {
 
     /// The rotation and its angular velocity (rad/s, in {b}) at t (s), clamped to [0, T].
     pub fn sample(&self, t: Real) -> (Rotation3, Vector3) {
+        let r = self.at_distance(self.bell.progress(t));
         match self.path {
-            RotationPath::Hold => (self.start, Vector3::zeros()),
+            RotationPath::Hold => (r, Vector3::zeros()),
+            RotationPath::About { axis } => (r, axis * self.bell.speed(t)),
+        }
+    }
+
+    /// The rotation after turning by `s` (rad) along the path, not limited to the bell's
+    /// distance.
+    pub fn at_distance(&self, s: Real) -> Rotation3 {
+        match self.path {
+            RotationPath::Hold => self.start,
             RotationPath::About { axis } => {
-                let turn = rotation_about(&axis, self.bell.progress(t));
-                let r = Rotation3::from_matrix_unchecked(turn * self.start.matrix());
-                (r, axis * self.bell.speed(t))
+                Rotation3::from_matrix_unchecked(rotation_about(&axis, s) * self.start.matrix())
             }
         }
     }
@@ -390,9 +405,14 @@ impl AngleReference {
 
     /// The angle (rad) and its rate (rad/s) at t (s), clamped to [0, T].
     pub fn sample(&self, t: Real) -> (Real, Real) {
-        let value = self.start + self.direction * self.bell.progress(t);
-        let value = if self.periodic { wrap_angle(value) } else { value };
-        (value, self.direction * self.bell.speed(t))
+        (self.at_distance(self.bell.progress(t)), self.direction * self.bell.speed(t))
+    }
+
+    /// The angle (rad) after changing by `s` (rad) in the path's direction, not limited to the
+    /// bell's distance.
+    pub fn at_distance(&self, s: Real) -> Real {
+        let value = self.start + self.direction * s;
+        if self.periodic { wrap_angle(value) } else { value }
     }
 }
 
@@ -610,6 +630,17 @@ impl Reference {
     /// The value at t = T: where the next segment of this variable starts.
     pub fn end(&self) -> Target {
         self.sample(self.duration()).value()
+    }
+
+    /// The value at `fraction` of the path's distance: 0 at the start, 1 at the end, and beyond
+    /// 1 further along the same path (a line past its end, a rotation further round).
+    pub fn at_fraction(&self, fraction: Real) -> Target {
+        let s = fraction * self.bell().distance();
+        match self {
+            Reference::Position(r) => Target::Position(r.at_distance(s)),
+            Reference::Rotation(r) => Target::Rotation(r.at_distance(s)),
+            Reference::Angle(r) => Target::Angle(r.at_distance(s)),
+        }
     }
 }
 
