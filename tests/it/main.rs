@@ -2,6 +2,7 @@
 
 mod collision;
 mod common;
+mod constrained_rrt;
 mod decompose;
 mod errors;
 mod ik;

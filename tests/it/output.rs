@@ -12,7 +12,7 @@ use a2ml::kinematics::{arm_pose, link_poses};
 use a2ml::language::{Shape, SolverChoice, Space, Task, Variable, parse};
 use a2ml::math::{JointVector, Real, Vector3};
 use a2ml::output::{ARM_CAPSULE_RATE, OutputError, topics, write_csv, write_json, write_mcap};
-use a2ml::solve::{Plan, QpStats, SegmentReport, VariableError};
+use a2ml::solve::{Fallback, Plan, QpStats, SegmentReport, VariableError};
 use a2ml::trajectory::{Clearance, Trajectory};
 use serde_json::Value;
 
@@ -23,7 +23,7 @@ const RATE: Real = 250.0;
 /// Number of samples: 0.4 s at [`RATE`].
 const SAMPLES: usize = 101;
 /// Fields that may be null although their schema gives another type (see `schemas.rs`).
-const NULLABLE: [&str; 5] = ["cpsa", "hat", "action_type", "clearance", "rrt"];
+const NULLABLE: [&str; 6] = ["cpsa", "hat", "action_type", "clearance", "rrt", "fallback"];
 
 /// The task of an example file, with its source.
 fn task(name: &str) -> (Task, String) {
@@ -59,6 +59,8 @@ fn report(action: &str, index: usize, start: Real, end: Real) -> SegmentReport {
             .then_some(VariableError { variable: Variable::Swivel, error: 0.01, within: true })
             .into_iter()
             .collect(),
+        hard_path: false,
+        path_kept: true,
         clearance: (index == 1).then(|| Clearance {
             distance: 0.05,
             time: end,
@@ -70,6 +72,7 @@ fn report(action: &str, index: usize, start: Real, end: Real) -> SegmentReport {
         reached: true,
         qp: QpStats { steps: 40, ..QpStats::default() },
         rrt: None,
+        fallback: (index == 1).then_some(Fallback::QpStalled),
     }
 }
 

@@ -194,11 +194,13 @@ def test_auto_runs_the_qp() -> None:
 
 
 def test_solver_overrides_the_task_and_its_actions() -> None:
-    """By default each action keeps its own solver (here `rrt`, not there
-    yet); `solver=` replaces every one."""
+    """By default each action keeps its own solver (here `qp` for the task,
+    `rrt` for one action); `solver=` replaces every one."""
     path = EXAMPLES / "construct_settings.a2ml"
-    with pytest.raises(PlanError, match="`sample_based`: solver `rrt` is not available yet"):
-        a2ml.plan(path)
+    own = a2ml.plan(path)
+    assert [s.solver for s in own.segments] == ["qp", "rrt"]
+    rrt = own.segments[1].rrt
+    assert rrt is not None and rrt.collision_checks > 0
     p = a2ml.plan(path, solver="qp")
     assert p.rate == 200.0
     assert [s.solver for s in p.segments] == ["qp"] * len(p.segments)
@@ -431,3 +433,19 @@ def test_auto_gives_a_goal_among_obstacles_to_the_rrt() -> None:
     assert report.to_dict()["rrt"] == report.rrt
     again = pickle.loads(pickle.dumps(report))
     assert again == report and again.rrt == report.rrt
+
+
+def test_auto_goes_on_to_the_rrt_when_the_qp_leaves_a_hard_path() -> None:
+    """Paper §6.2: round the forward bar the QP leaves the wrist's line; the
+    constrained RRT keeps it exactly."""
+    path = EXAMPLES / "type_iv_forward_bar.a2ml"
+    qp = a2ml.plan(path, solver="qp").segments[0]
+    assert qp.hard_path and not qp.path_kept and qp.fallback is None
+    assert qp.path_errors["pw"].error > 0.01
+    auto = a2ml.plan(path, solver="auto")
+    segment = auto.segments[0]
+    assert (segment.solver, segment.fallback) == ("rrt", "qp_left_path")
+    assert segment.path_kept and segment.reached and auto.reached
+    assert segment.path_errors["pw"].error < 1e-9
+    assert segment.to_dict()["fallback"] == "qp_left_path"
+    assert pickle.loads(pickle.dumps(segment)) == segment

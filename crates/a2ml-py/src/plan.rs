@@ -15,7 +15,7 @@ use a2ml_core::language::SolverChoice;
 use a2ml_core::math::{DOF, JointVector, Real, Vector3};
 use a2ml_core::output;
 use a2ml_core::solve::rrt::RrtStats;
-use a2ml_core::solve::{self, Plan, PlanOptions, QpStats, SegmentReport, VariableError};
+use a2ml_core::solve::{self, Fallback, Plan, PlanOptions, QpStats, SegmentReport, VariableError};
 use a2ml_core::trajectory::{Clearance, Trajectory};
 use numpy::IntoPyArray;
 use numpy::ndarray::Array2;
@@ -378,10 +378,29 @@ impl PySegmentReport {
         variable_errors(py, &self.report.errors)
     }
 
-    /// Largest deviation of each path variable from its reference.
+    /// Largest distance of each path variable from its path (its locus, whatever the timing).
     #[getter]
     fn path_errors<'py>(&self, py: Python<'py>) -> PyResult<Dict<'py>> {
         variable_errors(py, &self.report.path_errors)
+    }
+
+    /// Whether the path is a hard constraint (an action of type IV or VI).
+    #[getter]
+    fn hard_path(&self) -> bool {
+        self.report.hard_path
+    }
+
+    /// Whether the path was kept within tolerance throughout (always True for a soft path).
+    #[getter]
+    fn path_kept(&self) -> bool {
+        self.report.path_kept
+    }
+
+    /// Why `auto` went on from the QP to the solver named: "qp_stalled", "qp_missed_goal",
+    /// "qp_left_path", or None.
+    #[getter]
+    fn fallback(&self) -> Option<&'static str> {
+        self.report.fallback.map(Fallback::key)
     }
 
     /// The smallest clearance over the segment, or None.
@@ -457,12 +476,15 @@ impl PySegmentReport {
         d.set_item("settle", self.settle())?;
         d.set_item("errors", self.errors(py)?)?;
         d.set_item("path_errors", self.path_errors(py)?)?;
+        d.set_item("hard_path", self.hard_path())?;
+        d.set_item("path_kept", self.path_kept())?;
         d.set_item("clearance", self.clearance(py)?)?;
         d.set_item("limit_margin", self.limit_margin())?;
         d.set_item("stalled", self.stalled())?;
         d.set_item("reached", self.reached())?;
         d.set_item("qp", self.qp(py)?)?;
         d.set_item("rrt", self.rrt(py)?)?;
+        d.set_item("fallback", self.fallback())?;
         Ok(d)
     }
 
@@ -484,6 +506,7 @@ impl PySegmentReport {
         let clearance: Option<(Real, Real, String, String)> = item(d, "clearance")?.extract()?;
         let qp: (usize, usize, Real, Real, Real, Real) = item(d, "qp")?.extract()?;
         let rrt: Option<(usize, usize, usize, Real)> = item(d, "rrt")?.extract()?;
+        let fallback: Option<String> = item(d, "fallback")?.extract()?;
         let report = SegmentReport {
             action: item(d, "action")?.extract()?,
             action_index: item(d, "action_index")?.extract()?,
@@ -499,6 +522,8 @@ impl PySegmentReport {
             settle: item(d, "settle")?.extract()?,
             errors: read_variable_errors(&item(d, "errors")?)?,
             path_errors: read_variable_errors(&item(d, "path_errors")?)?,
+            hard_path: item(d, "hard_path")?.extract()?,
+            path_kept: item(d, "path_kept")?.extract()?,
             clearance: clearance.map(|(distance, time, link, obstacle)| Clearance {
                 distance,
                 time,
@@ -522,6 +547,12 @@ impl PySegmentReport {
                 collision_checks,
                 time,
             }),
+            fallback: fallback
+                .map(|name| {
+                    let found = Fallback::ALL.into_iter().find(|f| f.key() == name);
+                    found.ok_or_else(|| unknown("fallback", &name))
+                })
+                .transpose()?,
         };
         Ok(Self { report })
     }

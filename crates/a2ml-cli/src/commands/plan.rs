@@ -135,11 +135,21 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     }
 
     let missed = plan.segments.iter().filter(|s| !s.reached).count();
-    if missed > 0 {
+    let off_path = plan.segments.iter().filter(|s| !s.path_kept).count();
+    if missed + off_path > 0 {
+        let total = output::count(plan.segments.len(), "segment");
+        let mut failures = Vec::new();
+        if missed > 0 {
+            let goal = if missed == 1 { "its goal" } else { "their goals" };
+            failures.push(format!("{missed} of {total} missed {goal} beyond tolerance"));
+        }
+        if off_path > 0 {
+            let path = if off_path == 1 { "its hard path" } else { "their hard paths" };
+            failures.push(format!("{off_path} of {total} left {path}"));
+        }
         return Err(CliError::Missed(format!(
-            "{missed} of {} missed {} beyond tolerance; the plan was written all the same",
-            output::count(plan.segments.len(), "segment"),
-            if missed == 1 { "its goal" } else { "their goals" }
+            "{}; the plan was written all the same",
+            failures.join(", ")
         )));
     }
     Ok(())
@@ -249,7 +259,7 @@ fn summary(
                 goal_error(s, tolerance),
                 s.clearance.as_ref().map_or_else(|| "-".to_owned(), |c| num(c.distance * 1e3, 1)),
                 num(deg(s.limit_margin), COARSE),
-                status(s).to_owned(),
+                status(s),
             ],
         );
     }
@@ -285,13 +295,19 @@ fn goal_error(s: &SegmentReport, tolerance: &Tolerance) -> String {
     }
 }
 
-/// `ok`, `stalled` (stopped making progress short of the goal) or `missed`
-/// (the time ran out short of it).
-fn status(s: &SegmentReport) -> &'static str {
-    match (s.reached, s.stalled) {
-        (true, _) => "ok",
-        (false, true) => "stalled",
-        (false, false) => "missed",
+/// `ok`, `stalled` (stopped making progress short of the goal), `missed`
+/// (the time ran out short of it) or `off path` (a hard path left); after
+/// `auto` went on from the QP, why: `ok (qp stalled)`.
+fn status(s: &SegmentReport) -> String {
+    let outcome = match (s.path_kept, s.reached, s.stalled) {
+        (false, ..) => "off path",
+        (true, true, _) => "ok",
+        (true, false, true) => "stalled",
+        (true, false, false) => "missed",
+    };
+    match s.fallback {
+        Some(why) => format!("{outcome} ({})", why.name()),
+        None => outcome.to_owned(),
     }
 }
 

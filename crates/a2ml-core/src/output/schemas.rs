@@ -386,12 +386,19 @@ pub(super) fn segment() -> Schema {
         "settle": described("number", "s"),
         "errors": array(error.clone()),
         "path_errors": array(error),
+        "hard_path": b,
+        "path_kept": b,
         "clearance": clearance,
         "limit_margin": described("number", "rad"),
         "stalled": b,
         "reached": b,
         "qp": qp,
         "rrt": rrt,
+        "fallback": described(
+            "string",
+            "qp_stalled, qp_missed_goal or qp_left_path: why auto went on from the QP to the \
+             solver named; null if it did not"
+        ),
     });
     let required: Vec<&str> =
         fields.as_object().map(|m| m.keys().map(String::as_str).collect()).unwrap_or_default();

@@ -1,16 +1,17 @@
 //! A whole task: decompose, solve every segment from where the last one really ended, join
 //! segments (+Tr within an action, +Se between actions) and report on each.
 
+use super::constrained_rrt::{Chart, constrained_rrt, time_constrained};
 use super::qp::{self, Component, QpError, QpOptions, SegmentProblem};
-use super::report::{Plan, QpStats, SegmentReport, VariableError};
-use super::rrt::{RrtError, RrtOptions, RrtStats, rrt_connect, time_parameterise};
+use super::report::{Fallback, Plan, QpStats, SegmentReport, VariableError};
+use super::rrt::{RrtError, RrtOptions, RrtStats, TimedPath, rrt_connect, time_parameterise};
 use crate::collision::CollisionScene;
 use crate::decompose::{
     ArmState, DecomposeError, DecomposeOptions, PlannedAction, PlannedSegment, SegmentPattern,
     decompose, goal_error,
 };
 use crate::kinematics::{HatState, hat_to_cpsa, ik_cpsa};
-use crate::language::{PrimitiveConstraint, SolverChoice, Space, Task, Variable};
+use crate::language::{ActionBody, PrimitiveConstraint, SolverChoice, Space, Task, Variable};
 use crate::math::{DOF, JointVector, Real, Vector3};
 use crate::profile::{BodyFrames, ProfileError, Reference, Role, Sample};
 use crate::robot::Robot;
@@ -56,11 +57,10 @@ pub enum SolveError {
     },
     /// The solver asked for does not exist yet for this kind of segment.
     #[error(
-        "action `{action}`: solver `{}` is not available yet for pattern-{} segments; use `qp` \
-         or `auto`{}",
+        "action `{action}`: solver `{}` is not available yet for pattern-{} segments; use \
+         `auto`, `qp` or `rrt`",
         solver.name(),
-        pattern.number(),
-        if *solver == SolverChoice::Rrt { " (rrt plans goal segments, pattern 2, so far)" } else { "" }
+        pattern.number()
     )]
     UnsupportedSolver {
         /// The action.
@@ -156,6 +156,7 @@ pub fn plan_with_progress(
     };
     let mut warnings = state.notes;
     warnings.extend(state.segments.iter().filter(|s| !s.reached).map(missed));
+    warnings.extend(state.segments.iter().filter(|s| !s.path_kept).map(left_path));
     Ok(Plan {
         task: decomposition.task,
         joint_names: robot.joint_names().iter().map(|n| (*n).to_owned()).collect(),
@@ -183,6 +184,31 @@ struct Solver<'a> {
     notes: Vec<String>,
 }
 
+/// One segment to solve, with what every solver and the report need.
+struct Job<'a> {
+    action: &'a PlannedAction,
+    /// The segment's index in its action.
+    k: usize,
+    segment: &'a PlannedSegment,
+    problem: SegmentProblem,
+    /// The action's obstacles (its `contact` ones left out).
+    scene: &'a CollisionScene,
+    chart: Chart,
+    /// Whether the segment's path is the action's hard path.
+    hard: bool,
+}
+
+impl Job<'_> {
+    /// The warning prefix naming the action and segment.
+    fn name(&self) -> String {
+        format!("action `{}`, segment {}", self.action.name, self.k + 1)
+    }
+
+    fn rrt_failed(&self, source: RrtError) -> SolveError {
+        SolveError::Rrt { action: self.action.name.clone(), segment: self.k, source }
+    }
+}
+
 impl Solver<'_> {
     /// Solves and joins the action's segments, calling `solved` with the number of segments
     /// solved in the whole plan after each.
@@ -192,12 +218,32 @@ impl Solver<'_> {
         solved: &mut dyn FnMut(usize),
     ) -> Result<(), SolveError> {
         let scene = CollisionScene::new(&self.task.action_scene(action.index));
+        let hard = matches!(
+            &self.task.actions[action.index].body,
+            ActionBody::Constraints { path: Some(path), .. } if path.hard
+        );
         let action_start = self.whole.as_ref().map_or(0.0, Trajectory::end);
         let mut joined: Option<Trajectory> = None;
         let mut last: Option<(Real, Real)> = None; // (start, duration) of the previous segment
         for (k, segment) in action.segments.iter().enumerate() {
             let problem = self.problem(action, k, segment)?;
-            let solution = self.solve(action, k, segment, &problem, &scene)?;
+            let chart = Chart::new(self.robot, &problem);
+            // A hard path gives the segments that carry it their path primitives; the
+            // decomposition's holds are kept as exactly by every solver, hard or not.
+            let carries_path = segment
+                .primitives
+                .iter()
+                .any(|p| matches!(p.constraint, PrimitiveConstraint::Path(_)));
+            let job = Job {
+                action,
+                k,
+                segment,
+                problem,
+                scene: &scene,
+                chart,
+                hard: hard && carries_path,
+            };
+            let solution = self.solve(&job)?;
             let duration = solution.trajectory.duration();
             let (start, next) = match (joined.take(), last) {
                 (Some(before), Some((prev_start, prev_duration))) => {
@@ -212,8 +258,8 @@ impl Solver<'_> {
             if let Some(end) = solution.trajectory.positions().last() {
                 self.q = *end;
             }
-            self.reference(&problem, start);
-            let report = self.report(action, k, segment, &problem, &solution, &scene, start);
+            self.reference(&job.problem, start);
+            let report = self.report(&job, &solution, start);
             self.segments.push(report);
             solved(self.segments.len());
         }
@@ -226,121 +272,178 @@ impl Solver<'_> {
         Ok(())
     }
 
-    /// Solves one segment with its solver: the override, else its own choice. `auto`
-    /// (DESIGN.md §5) gives a goal segment among obstacles to the RRT, falling back to the QP
-    /// with a warning when the RRT finds no path, and every other segment to the QP.
-    fn solve(
-        &mut self,
-        action: &PlannedAction,
-        k: usize,
-        segment: &PlannedSegment,
-        problem: &SegmentProblem,
-        scene: &CollisionScene,
-    ) -> Result<Solved, SolveError> {
-        let goal = segment.pattern == SegmentPattern::Goal;
-        match self.options.solver.unwrap_or(segment.solver) {
-            SolverChoice::Qp => self.qp(action, k, problem, scene),
-            SolverChoice::Auto if goal && !scene.is_empty() => {
-                match self.rrt(action, k, segment, problem, scene) {
+    /// Solves one segment with its solver: the override, else its own choice. `rrt` plans a
+    /// goal segment (pattern 2) in joint space and a segment with a path (patterns 1 and 3) in
+    /// its constrained space. `auto` (DESIGN.md §5) gives a goal segment among obstacles to
+    /// the RRT, falling back to the QP with a warning when the RRT finds no path; it gives a
+    /// mixed segment (pattern 3) to the QP and, when the QP stalls, misses the goal or leaves
+    /// a hard path, to the constrained RRT, keeping the QP's closest result with a warning
+    /// when that fails too; and every other segment to the QP.
+    fn solve(&mut self, job: &Job) -> Result<Solved, SolveError> {
+        let pattern = job.segment.pattern;
+        let kept = |this: &mut Self, source: RrtError, why: &str| {
+            let name = job.name();
+            this.notes.push(format!("{name}: {why}; rrt: {source}; the QP's result is kept"));
+        };
+        match self.options.solver.unwrap_or(job.segment.solver) {
+            SolverChoice::Qp => self.qp(job),
+            SolverChoice::Auto if pattern == SegmentPattern::Goal && !job.scene.is_empty() => {
+                match self.rrt(job) {
                     Ok(solved) => Ok(solved),
                     Err(SolveError::Rrt { source, .. }) => {
-                        self.notes.push(format!(
-                            "action `{}`, segment {}: rrt: {source}; the QP's result is kept",
-                            action.name,
-                            k + 1
-                        ));
-                        self.qp(action, k, problem, scene)
+                        kept(self, source, "a goal segment among obstacles");
+                        self.qp(job)
                     }
                     Err(e) => Err(e),
                 }
             }
-            SolverChoice::Auto => self.qp(action, k, problem, scene),
-            SolverChoice::Rrt if goal => self.rrt(action, k, segment, problem, scene),
+            SolverChoice::Auto if pattern == SegmentPattern::Mixed => {
+                let qp = self.qp(job)?;
+                let why = match (qp.reached, qp.path_kept, qp.stalled) {
+                    (true, true, _) => return Ok(qp),
+                    (_, false, _) => Fallback::QpLeftPath,
+                    (_, _, true) => Fallback::QpStalled,
+                    _ => Fallback::QpMissedGoal,
+                };
+                match self.constrained(job) {
+                    Ok(rrt) if rrt.reached && rrt.path_kept => {
+                        Ok(Solved { fallback: Some(why), ..rrt })
+                    }
+                    Ok(_) => {
+                        self.notes.push(format!(
+                            "{}: {}; rrt did not do better; the QP's result is kept",
+                            job.name(),
+                            why.describe()
+                        ));
+                        Ok(qp)
+                    }
+                    Err(SolveError::Rrt { source, .. }) => {
+                        kept(self, source, why.describe());
+                        Ok(qp)
+                    }
+                    Err(e) => Err(e),
+                }
+            }
+            SolverChoice::Auto => self.qp(job),
+            SolverChoice::Rrt if pattern == SegmentPattern::Goal => self.rrt(job),
+            SolverChoice::Rrt => self.constrained(job),
             solver => Err(SolveError::UnsupportedSolver {
-                action: action.name.clone(),
+                action: job.action.name.clone(),
                 solver,
-                pattern: segment.pattern,
+                pattern,
             }),
         }
     }
 
-    fn qp(
-        &self,
-        action: &PlannedAction,
-        k: usize,
-        problem: &SegmentProblem,
-        scene: &CollisionScene,
-    ) -> Result<Solved, SolveError> {
-        let solution = qp::solve_segment(self.robot, scene, problem, &self.q, &self.options.qp)
-            .map_err(|source| SolveError::Qp { action: action.name.clone(), segment: k, source })?;
+    fn qp(&self, job: &Job) -> Result<Solved, SolveError> {
+        let solution =
+            qp::solve_segment(self.robot, job.scene, &job.problem, &self.q, &self.options.qp)
+                .map_err(|source| SolveError::Qp {
+                    action: job.action.name.clone(),
+                    segment: job.k,
+                    source,
+                })?;
+        let (path_errors, path_kept) = self.assess(job, &solution.trajectory);
         Ok(Solved {
             solver: SolverChoice::Qp,
             trajectory: solution.trajectory,
             errors: solution.errors,
-            max_errors: solution.max_errors,
+            path_errors,
+            path_kept,
             settle: solution.settle,
             reached: solution.reached,
             stalled: solution.stalled,
             qp: solution.stats,
             rrt: None,
+            fallback: None,
         })
     }
 
     /// A goal segment by RRT-Connect in joint space towards the IK branches of its end state
     /// (the decomposition's configuration first), timed with the bell profile.
-    fn rrt(
-        &mut self,
-        action: &PlannedAction,
-        k: usize,
-        segment: &PlannedSegment,
-        problem: &SegmentProblem,
-        scene: &CollisionScene,
-    ) -> Result<Solved, SolveError> {
-        let mut goals = vec![segment.end];
-        if let Ok(state) = ArmState::at(self.robot, &segment.end) {
-            if let Ok(branches) = ik_cpsa(self.robot, &state.cpsa, Some(&segment.end)) {
-                goals.extend(branches.into_iter().filter(|q| (q - segment.end).amax() > 1e-9));
+    fn rrt(&mut self, job: &Job) -> Result<Solved, SolveError> {
+        let end = job.segment.end;
+        let mut goals = vec![end];
+        if let Ok(state) = ArmState::at(self.robot, &end) {
+            if let Ok(branches) = ik_cpsa(self.robot, &state.cpsa, Some(&end)) {
+                goals.extend(branches.into_iter().filter(|q| (q - end).amax() > 1e-9));
             }
         }
-        let options = RrtOptions {
+        let path = rrt_connect(self.robot, job.scene, &self.q, &goals, &self.rrt_options())
+            .map_err(|e| job.rrt_failed(e))?;
+        let rate = 1.0 / self.options.qp.step;
+        let timed = time_parameterise(self.robot, &path.waypoints, job.segment.duration, rate)?;
+        Ok(self.timed(job, timed, path.stats))
+    }
+
+    /// A segment with a path by RRT-Connect in its constrained space, timed with the bell
+    /// profile along the chart path.
+    fn constrained(&mut self, job: &Job) -> Result<Solved, SolveError> {
+        let options = self.rrt_options();
+        let path = constrained_rrt(self.robot, job.scene, &job.chart, &self.q, &options)
+            .map_err(|e| job.rrt_failed(e))?;
+        let rate = 1.0 / self.options.qp.step;
+        let timed = time_constrained(self.robot, &job.chart, &path, job.segment.duration, rate)
+            .map_err(|e| job.rrt_failed(e))?;
+        Ok(self.timed(job, timed, path.stats))
+    }
+
+    fn rrt_options(&self) -> RrtOptions {
+        RrtOptions {
             seed: self.task.settings.seed,
             clearance: self.options.qp.safety_distance,
             ..self.options.rrt
-        };
-        let failed = |source| SolveError::Rrt { action: action.name.clone(), segment: k, source };
-        let path = rrt_connect(self.robot, scene, &self.q, &goals, &options).map_err(failed)?;
-        let timed = time_parameterise(
-            self.robot,
-            &path.waypoints,
-            segment.duration,
-            1.0 / self.options.qp.step,
-        )?;
+        }
+    }
+
+    /// An RRT path as solved: the stretch noted, the end's errors.
+    fn timed(&mut self, job: &Job, timed: TimedPath, stats: RrtStats) -> Solved {
         if timed.stretched {
             self.notes.push(format!(
-                "action `{}`, segment {}: the rrt path takes {:.2} s instead of {:.2} s to keep \
-                 every joint within its speed limit",
-                action.name,
-                k + 1,
+                "{}: the rrt path takes {:.2} s instead of {:.2} s to keep every joint within \
+                 its speed limit",
+                job.name(),
                 timed.duration,
-                segment.duration
+                job.segment.duration
             ));
         }
         let end = timed.trajectory.positions().last().copied().unwrap_or(self.q);
-        let errors = end_errors(self.robot, problem, &end);
+        let errors = end_errors(self.robot, &job.problem, &end);
         let tolerance = &self.options.qp.tolerance;
         let reached =
-            problem.components.iter().zip(errors).all(|(c, e)| e <= tolerance.of(c.variable));
-        Ok(Solved {
+            job.problem.components.iter().zip(errors).all(|(c, e)| e <= tolerance.of(c.variable));
+        let (path_errors, path_kept) = self.assess(job, &timed.trajectory);
+        Solved {
             solver: SolverChoice::Rrt,
             trajectory: timed.trajectory,
             errors,
-            max_errors: errors,
+            path_errors,
+            path_kept,
             settle: 0.0,
             reached,
             stalled: false,
             qp: QpStats::default(),
-            rrt: Some(path.stats),
-        })
+            rrt: Some(stats),
+            fallback: None,
+        }
+    }
+
+    /// The largest distance of each path component from its path over the trajectory, and
+    /// whether a hard path was kept within tolerance.
+    fn assess(&self, job: &Job, trajectory: &Trajectory) -> ([Real; 3], bool) {
+        let tolerance = &self.options.qp.tolerance;
+        let mut worst = [0.0; 3];
+        for q in trajectory.positions() {
+            let Ok(state) = ArmState::at(self.robot, q) else {
+                return ([Real::INFINITY; 3], !job.hard);
+            };
+            for (w, e) in worst.iter_mut().zip(job.chart.deviation(&state, tolerance)) {
+                *w = Real::max(*w, e);
+            }
+        }
+        let within =
+            job.problem.components.iter().zip(worst).all(|(c, e)| e <= tolerance.of(c.variable));
+        (worst, within || !job.hard)
     }
 
     /// The segment's references, starting from where the arm really is.
@@ -403,34 +506,25 @@ impl Solver<'_> {
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn report(
-        &self,
-        action: &PlannedAction,
-        k: usize,
-        segment: &PlannedSegment,
-        problem: &SegmentProblem,
-        solution: &Solved,
-        scene: &CollisionScene,
-        start: Real,
-    ) -> SegmentReport {
+    fn report(&self, job: &Job, solution: &Solved, start: Real) -> SegmentReport {
         let tolerance = &self.options.qp.tolerance;
         let error = |variable: Variable, error: Real| VariableError {
             variable,
             error,
             within: error <= tolerance.of(variable),
         };
-        let components = problem.components.iter();
+        let components = job.problem.components.iter();
         let errors = components.clone().zip(solution.errors).map(|(c, e)| error(c.variable, e));
         let path_errors = components
-            .zip(solution.max_errors)
+            .zip(solution.path_errors)
             .filter(|(c, _)| c.role == Role::Path)
             .map(|(c, e)| error(c.variable, e))
             .collect();
+        let (action, segment) = (job.action, job.segment);
         SegmentReport {
             action: action.name.clone(),
             action_index: action.index,
-            segment: k,
+            segment: job.k,
             action_type: action.classification.as_ref().map(|c| c.action_type),
             space: segment.space,
             pattern: segment.pattern,
@@ -442,12 +536,15 @@ impl Solver<'_> {
             settle: solution.settle,
             errors: errors.collect(),
             path_errors,
-            clearance: trajectory::min_clearance(&solution.trajectory, self.robot, scene),
+            hard_path: job.hard,
+            path_kept: solution.path_kept,
+            clearance: trajectory::min_clearance(&solution.trajectory, self.robot, job.scene),
             limit_margin: limit_margin(self.robot, &solution.trajectory),
             stalled: solution.stalled,
             reached: solution.reached,
             qp: solution.qp,
             rrt: solution.rrt,
+            fallback: solution.fallback,
         }
     }
 }
@@ -458,12 +555,17 @@ struct Solved {
     /// From time 0.
     trajectory: Trajectory,
     errors: [Real; 3],
-    max_errors: [Real; 3],
+    /// Largest distance of each component from its path (0 for goals).
+    path_errors: [Real; 3],
+    /// The path kept within tolerance, or not hard.
+    path_kept: bool,
     settle: Real,
     reached: bool,
     stalled: bool,
     qp: QpStats,
     rrt: Option<RrtStats>,
+    /// Why `auto` went on from the QP to this solver.
+    fallback: Option<Fallback>,
 }
 
 /// Each component's error at configuration `q` against its reference's end: distance for
@@ -509,17 +611,28 @@ fn limit_margin(robot: &Robot, trajectory: &Trajectory) -> Real {
         .fold(Real::INFINITY, Real::min)
 }
 
+/// The warning for a segment that left its hard path.
+fn left_path(s: &SegmentReport) -> String {
+    let what: Vec<String> = s.path_errors.iter().filter(|e| !e.within).map(describe).collect();
+    format!(
+        "action `{}`, segment {}: left its hard path: {}",
+        s.action,
+        s.segment + 1,
+        what.join(", ")
+    )
+}
+
+/// "Pw by 3.1 mm", "θsw by 2.00°".
+fn describe(e: &VariableError) -> String {
+    match e.variable {
+        Variable::Pw => format!("Pw by {:.1} mm", e.error * 1e3),
+        v => format!("{} by {:.2}°", v.symbol(), e.error.to_degrees()),
+    }
+}
+
 /// The warning for a segment that missed its goal.
 fn missed(s: &SegmentReport) -> String {
-    let what: Vec<String> = s
-        .errors
-        .iter()
-        .filter(|e| !e.within)
-        .map(|e| match e.variable {
-            Variable::Pw => format!("Pw by {:.1} mm", e.error * 1e3),
-            v => format!("{} by {:.2}°", v.symbol(), e.error.to_degrees()),
-        })
-        .collect();
+    let what: Vec<String> = s.errors.iter().filter(|e| !e.within).map(describe).collect();
     let why = if s.stalled { ", stalled" } else { "" };
     format!("action `{}`, segment {}: missed {}{why}", s.action, s.segment + 1, what.join(", "))
 }

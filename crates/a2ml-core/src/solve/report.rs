@@ -41,6 +41,50 @@ pub struct VariableError {
     pub within: bool,
 }
 
+/// Why `auto` went on from the QP to the constrained RRT on a segment with a path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Fallback {
+    /// The QP stopped making progress short of the goal.
+    QpStalled,
+    /// The QP's time ran out short of the goal.
+    QpMissedGoal,
+    /// The QP left the segment's hard path.
+    QpLeftPath,
+}
+
+impl Fallback {
+    /// Every reason.
+    pub const ALL: [Fallback; 3] = [Self::QpStalled, Self::QpMissedGoal, Self::QpLeftPath];
+
+    /// The name in JSON, MCAP and Python: `qp_stalled`, `qp_missed_goal`, `qp_left_path`.
+    pub fn key(self) -> &'static str {
+        match self {
+            Self::QpStalled => "qp_stalled",
+            Self::QpMissedGoal => "qp_missed_goal",
+            Self::QpLeftPath => "qp_left_path",
+        }
+    }
+
+    /// Short form for tables: `qp stalled`, `qp missed goal`, `qp left path`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::QpStalled => "qp stalled",
+            Self::QpMissedGoal => "qp missed goal",
+            Self::QpLeftPath => "qp left path",
+        }
+    }
+
+    /// As a sentence: `the QP stalled`.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::QpStalled => "the QP stalled",
+            Self::QpMissedGoal => "the QP missed the goal",
+            Self::QpLeftPath => "the QP left the hard path",
+        }
+    }
+}
+
 /// Counters and timings of the velocity QP over one segment.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
 pub struct QpStats {
@@ -89,9 +133,15 @@ pub struct SegmentReport {
     pub settle: Real,
     /// Final error of every variable of the segment's space.
     pub errors: Vec<VariableError>,
-    /// Largest deviation of each path variable (paths and holds) from its reference over the
-    /// segment.
+    /// Largest distance of each path variable (paths and holds) from its path over the
+    /// segment: from the path's locus, whatever the timing along it (see
+    /// [`crate::solve::constrained_rrt::Chart::deviation`]).
     pub path_errors: Vec<VariableError>,
+    /// Whether the path is a hard constraint (an action of type IV or VI).
+    pub hard_path: bool,
+    /// Whether the path was kept within tolerance throughout; always true for a soft path,
+    /// which may give way.
+    pub path_kept: bool,
     /// Smallest clearance over the segment's samples, if there is any pair to measure.
     pub clearance: Option<Clearance>,
     /// Smallest distance of any joint to its position limits over the segment (rad).
@@ -104,6 +154,8 @@ pub struct SegmentReport {
     pub qp: QpStats,
     /// RRT counters, when the RRT solved the segment.
     pub rrt: Option<crate::solve::rrt::RrtStats>,
+    /// Why `auto` went on from the QP to the solver that produced the segment.
+    pub fallback: Option<Fallback>,
 }
 
 /// A planned task: the whole joint trajectory at the output rate and what each segment did.
@@ -130,8 +182,8 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// Whether every segment reached its goals within tolerance.
+    /// Whether every segment reached its goals within tolerance and kept its hard path.
     pub fn reached(&self) -> bool {
-        self.segments.iter().all(|s| s.reached)
+        self.segments.iter().all(|s| s.reached && s.path_kept)
     }
 }

@@ -73,6 +73,14 @@ pub struct RrtStats {
     pub time: Real,
 }
 
+impl RrtStats {
+    /// The counters of a search started at `started`.
+    pub(crate) fn since(started: Instant, samples: usize, nodes: usize, checks: usize) -> Self {
+        let time = started.elapsed().as_secs_f64();
+        Self { samples, nodes, collision_checks: checks, time }
+    }
+}
+
 /// Why no path was found.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RrtError {
@@ -89,10 +97,29 @@ pub enum RrtError {
         reason: String,
     },
     /// No goal configuration is within the limits and clear.
-    #[error("none of the {count} goal configurations is within the limits and clear")]
+    #[error(
+        "{}",
+        if *count == 0 {
+            "the goal state has no IK solution within the joint limits".to_owned()
+        } else {
+            format!("none of the {count} goal configurations is within the limits and clear")
+        }
+    )]
     NoValidGoal {
         /// Goal configurations given.
         count: usize,
+    },
+    /// The IK cannot follow a constrained path between its checked points.
+    #[error("the IK loses the path's branch at arc length {at:.4}")]
+    Tracking {
+        /// Chart arc length where it happens.
+        at: Real,
+    },
+    /// A path cannot be timed.
+    #[error("timing the path: {reason}")]
+    Timing {
+        /// Why.
+        reason: String,
     },
     /// The search ran out of samples or time.
     #[error(
@@ -189,16 +216,21 @@ pub fn rrt_connect(
         }
         swapped = !swapped;
     }
-    let closest = from_start
-        .nodes
-        .iter()
-        .flat_map(|a| from_goal.nodes.iter().map(move |b| (a.q - b.q).norm()))
-        .fold(Real::INFINITY, Real::min);
+    let closest =
+        closest_pair(from_start.nodes.iter().map(|n| &n.q), from_goal.nodes.iter().map(|n| &n.q));
     let nodes = from_start.nodes.len() + from_goal.nodes.len();
     Err(RrtError::NoPath { closest, stats: space.stats(samples, nodes, started) })
 }
 
-fn check_options(o: &RrtOptions) -> Result<(), RrtError> {
+/// The joint-space distance between the closest configurations of two trees (rad).
+pub(crate) fn closest_pair<'a>(
+    a: impl Iterator<Item = &'a JointVector>,
+    b: impl Iterator<Item = &'a JointVector> + Clone,
+) -> Real {
+    a.flat_map(|p| b.clone().map(move |q| (p - q).norm())).fold(Real::INFINITY, Real::min)
+}
+
+pub(crate) fn check_options(o: &RrtOptions) -> Result<(), RrtError> {
     let positive = |x: Real| x.is_finite() && x > 0.0;
     let checks = [
         (positive(o.step), "the step must be positive"),
@@ -319,12 +351,7 @@ impl<'a> Space<'a> {
     }
 
     fn stats(&self, samples: usize, nodes: usize, started: Instant) -> RrtStats {
-        RrtStats {
-            samples,
-            nodes,
-            collision_checks: self.checks,
-            time: started.elapsed().as_secs_f64(),
-        }
+        RrtStats::since(started, samples, nodes, self.checks)
     }
 }
 

@@ -477,7 +477,17 @@ class SegmentReport:
 
     @property
     def path_errors(self) -> dict[str, VariableError]:
-        """The largest deviation of each path or held variable from its reference."""
+        """The largest distance of each path or held variable from its path (the
+        path's locus, whatever the timing along it)."""
+
+    @property
+    def hard_path(self) -> bool:
+        """Whether the segment's path is a hard constraint (action type IV or VI)."""
+
+    @property
+    def path_kept(self) -> bool:
+        """Whether the path was kept within tolerance throughout (always True
+        for a soft path, which may give way)."""
 
     @property
     def clearance(self) -> Clearance | None:
@@ -503,6 +513,10 @@ class SegmentReport:
     @property
     def rrt(self) -> RrtStats | None:
         """The RRT's counters when the RRT solved the segment, else None."""
+
+    @property
+    def fallback(self) -> Literal["qp_stalled", "qp_missed_goal", "qp_left_path"] | None:
+        """Why ``auto`` went on from the QP to the solver named, else None."""
 
     def to_dict(self) -> dict[str, Any]:
         """Every field above in one dict (records as their NamedTuples), e.g.
