@@ -169,5 +169,39 @@ fn rrt(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, qp, tasks, rrt);
+/// Paper §6.2's forward bar (examples/type_iv_forward_bar.a2ml, Centauro): the whole plan with
+/// the constrained RRT, one type IV segment. Prints the median over 100 seeds first.
+fn constrained_rrt(c: &mut Criterion) {
+    let task = language::load(path("examples/type_iv_forward_bar.a2ml")).expect("task loads");
+    let robot = Robot::from_urdf_file(&task.robot).expect("robot");
+    let options =
+        PlanOptions { solver: Some(language::SolverChoice::Rrt), ..PlanOptions::default() };
+    let (mut times, mut checks, mut found) = (Vec::new(), Vec::new(), 0);
+    for seed in 0..100 {
+        let mut task = task.clone();
+        task.settings.seed = seed;
+        let started = std::time::Instant::now();
+        if let Ok(p) = plan(&robot, &task, &options) {
+            times.push(started.elapsed().as_secs_f64());
+            checks.extend(p.segments[0].rrt.map(|r| r.collision_checks));
+            found += 1;
+        }
+    }
+    times.sort_by(Real::total_cmp);
+    checks.sort_unstable();
+    eprintln!(
+        "rrt/forward_bar: {found} of 100 seeds found a path; median {:.1} ms (plan, timing \
+         included) and {} collision checks",
+        times.get(times.len() / 2).copied().unwrap_or(Real::NAN) * 1e3,
+        checks.get(checks.len() / 2).copied().unwrap_or(0)
+    );
+    let mut group = c.benchmark_group("rrt");
+    group.sample_size(20);
+    group.bench_function("forward_bar_plan", |b| {
+        b.iter(|| plan(&robot, black_box(&task), &options))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, qp, tasks, rrt, constrained_rrt);
 criterion_main!(benches);
