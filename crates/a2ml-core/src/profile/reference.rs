@@ -3,7 +3,9 @@
 
 use super::{BellProfile, ProfileError};
 use crate::language::{Axis, BodyAxis, PathFeature, Target, ValueKind, Variable};
-use crate::math::{Real, Rotation3, Vector3, rotation_about, rotation_log, wrap_angle};
+use crate::math::{
+    Real, Rotation3, Vector3, reject, rotation_about, rotation_log, skew, wrap_angle,
+};
 
 /// Directions shorter than this are treated as undefined.
 const MIN_AXIS_NORM: Real = 1e-12;
@@ -195,6 +197,20 @@ impl PositionReference {
         }
     }
 
+    /// The distance along the path (unbounded, as [`Self::at_distance`]) of the path's point
+    /// nearest to `p`: its projection on a line, its angle about the axis for a rotation (in
+    /// (-π, π]); 0 for a hold.
+    pub fn nearest_distance(&self, p: &Vector3) -> Real {
+        match self.path {
+            PositionPath::Hold => 0.0,
+            PositionPath::Line { direction } => (p - self.start).dot(&direction),
+            PositionPath::About { axis } => {
+                let (a, b) = (reject(&self.start, &axis), reject(p, &axis));
+                axis.dot(&a.cross(&b)).atan2(a.dot(&b))
+            }
+        }
+    }
+
     /// Pw (m, {b}) at distance `s` along the path (m for a line, rad for a rotation), not
     /// limited to the bell's distance: a line goes on past its end.
     pub fn at_distance(&self, s: Real) -> Vector3 {
@@ -311,6 +327,21 @@ impl RotationReference {
         }
     }
 
+    /// The angle (rad, in (-π, π]) along the path of the path's rotation nearest to `r` (the
+    /// smallest geodesic angle); 0 for a hold. With M = R R0ᵀ and a the axis,
+    /// tr(Rot(a, s)ᵀ M) = aᵀMa + (tr M − aᵀMa) cos s − tr([a]× M) sin s, largest at
+    /// s = atan2(−tr([a]× M), tr M − aᵀMa).
+    pub fn nearest_distance(&self, r: &Rotation3) -> Real {
+        match self.path {
+            RotationPath::Hold => 0.0,
+            RotationPath::About { axis } => {
+                let m = r.matrix() * self.start.matrix().transpose();
+                let along = axis.dot(&(m * axis));
+                (-(skew(&axis) * m).trace()).atan2(m.trace() - along)
+            }
+        }
+    }
+
     /// The rotation after turning by `s` (rad) along the path, not limited to the bell's
     /// distance.
     pub fn at_distance(&self, s: Real) -> Rotation3 {
@@ -406,6 +437,13 @@ impl AngleReference {
     /// The angle (rad) and its rate (rad/s) at t (s), clamped to [0, T].
     pub fn sample(&self, t: Real) -> (Real, Real) {
         (self.at_distance(self.bell.progress(t)), self.direction * self.bell.speed(t))
+    }
+
+    /// The change (rad) in the path's direction that reaches `angle`: the shorter way round,
+    /// in (-π, π], when periodic.
+    pub fn nearest_distance(&self, angle: Real) -> Real {
+        let change = angle - self.start;
+        self.direction * if self.periodic { wrap_angle(change) } else { change }
     }
 
     /// The angle (rad) after changing by `s` (rad) in the path's direction, not limited to the
@@ -632,6 +670,23 @@ impl Reference {
         self.sample(self.duration()).value()
     }
 
+    /// The fraction of the path's distance (unbounded, as [`Self::at_fraction`]) at which the
+    /// path comes nearest to `value`; `None` for a path that does not move (a hold, or a
+    /// distance of 0) or a value of another kind.
+    pub fn nearest_fraction(&self, value: &Target) -> Option<Real> {
+        let distance = self.bell().distance();
+        if distance <= 0.0 {
+            return None;
+        }
+        let s = match (self, value) {
+            (Reference::Position(r), Target::Position(p)) => r.nearest_distance(p),
+            (Reference::Rotation(r), Target::Rotation(q)) => r.nearest_distance(q),
+            (Reference::Angle(r), Target::Angle(a)) => r.nearest_distance(*a),
+            _ => return None,
+        };
+        Some(s / distance)
+    }
+
     /// The value at `fraction` of the path's distance: 0 at the start, 1 at the end, and beyond
     /// 1 further along the same path (a line past its end, a rotation further round).
     pub fn at_fraction(&self, fraction: Real) -> Target {
@@ -806,5 +861,31 @@ mod tests {
             Target::Angle(a) => assert!((a - (3.2 - 2.0 * PI)).abs() < 1e-15),
             other => panic!("{other:?}"),
         }
+    }
+
+    #[test]
+    fn nearest_fraction_finds_the_fraction_of_a_point_on_the_path() {
+        let p0 = Vector3::new(0.3, -0.1, -0.2);
+        let axis = Vector3::new(0.2, -0.4, 0.9).normalize();
+        let r0 = rot(Vector3::new(0.5, 0.1, -0.3), 0.8);
+        let references = [
+            Reference::Position(PositionReference::line(p0, &axis, 0.2, 1.0).expect("valid")),
+            Reference::Position(PositionReference::about(p0, &axis, -1.1, 1.0).expect("valid")),
+            Reference::Rotation(RotationReference::about(r0, &axis, 1.3, 1.0).expect("valid")),
+            Reference::Angle(AngleReference::by(2.9, 0.6, true, 1.0).expect("valid")),
+            Reference::Angle(AngleReference::by(1.0, -0.7, false, 1.0).expect("valid")),
+        ];
+        for (i, r) in references.iter().enumerate() {
+            for f in [0.0, 0.3, 1.0, 1.4] {
+                let found = r.nearest_fraction(&r.at_fraction(f)).expect("a moving path");
+                assert!((found - f).abs() < 1e-12, "reference {i}: {found} for {f}");
+            }
+        }
+        // Off the line: the projection.
+        let line = &references[0];
+        let off = Target::Position(p0 + axis * 0.1 + axis.cross(&Vector3::x()).normalize() * 0.05);
+        assert!((line.nearest_fraction(&off).expect("moving") - 0.5).abs() < 1e-12);
+        let hold = Reference::hold(Variable::Pw, Target::Position(p0), 1.0).expect("valid");
+        assert_eq!(hold.nearest_fraction(&Target::Position(p0)), None);
     }
 }

@@ -36,12 +36,12 @@ use rand::{RngExt, SeedableRng};
 
 use super::qp::SegmentProblem;
 use super::report::Tolerance;
-use super::rrt::{RrtError, RrtOptions, RrtStats, TimedPath, closest_pair};
+use super::rrt::{Extension, RrtError, RrtOptions, RrtStats, TimedPath, closest_pair, nearest};
 use crate::collision::{CollisionModel, CollisionScene, advancement, clearance, motion_bound};
 use crate::decompose::{ArmState, goal_error};
 use crate::kinematics::{CpsaState, HatState, ik_cpsa, ik_hat, swivel_intervals};
 use crate::language::{Space, Target, Variable};
-use crate::math::{JointVector, Real, Rotation3, rotation_distance, rotation_log, wrap_angle};
+use crate::math::{JointVector, PI, Real, Rotation3, rotation_distance, rotation_log, wrap_angle};
 use crate::profile::{BellProfile, Reference, Role};
 use crate::robot::Robot;
 use crate::trajectory::{Trajectory, TrajectoryError, sample_times};
@@ -220,27 +220,59 @@ impl Chart {
         if self.sigma_max <= 0.0 {
             return errors(0.0);
         }
+        let best_of = |candidates: &[Real]| -> [Real; 3] {
+            let sigma = candidates.iter().copied().min_by(|a, b| worst(*a).total_cmp(&worst(*b)));
+            errors(sigma.unwrap_or(0.0))
+        };
+        // One moving path component (the usual case): the σ nearest in closed form; the other
+        // path components are holds, the same at every σ.
+        let moving: Vec<usize> = (0..3)
+            .filter(|&k| self.on_path[k] && self.references[k].bell().distance() > 0.0)
+            .collect();
+        if let [k] = moving[..] {
+            let value = state.value(self.variables[k]);
+            if let Some(sigma) = self.references[k].nearest_fraction(&value) {
+                // Angles come back in (-π, π]: a turn by more than π may be nearer a turn on.
+                let turn = 2.0 * PI / self.references[k].bell().distance();
+                let clamped = |s: Real| s.clamp(0.0, self.sigma_max);
+                let candidates = [sigma - turn, sigma, sigma + turn].map(clamped);
+                return best_of(&[
+                    candidates[0],
+                    candidates[1],
+                    candidates[2],
+                    0.0,
+                    self.sigma_max,
+                ]);
+            }
+        }
         // A scan, then golden-section search in the best bracket: the worst error along the
-        // path is unimodal near its minimum, not necessarily over the whole path.
+        // path is unimodal near its minimum, not necessarily over the whole path. Each point
+        // is evaluated once: the grid's values are kept, and each golden step reuses one.
         const SCAN: usize = 64;
         let h = self.sigma_max / SCAN as Real;
         let best = (0..=SCAN)
-            .map(|i| i as Real * h)
-            .min_by(|a, b| worst(*a).total_cmp(&worst(*b)))
-            .unwrap_or(0.0);
+            .map(|i| {
+                let sigma = i as Real * h;
+                (sigma, worst(sigma))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(0.0, |(sigma, _)| sigma);
         let (mut lo, mut hi) = ((best - h).max(0.0), (best + h).min(self.sigma_max));
         let ratio = 0.5 * (5.0_f64.sqrt() - 1.0);
+        let (mut a, mut b) = (hi - ratio * (hi - lo), lo + ratio * (hi - lo));
+        let (mut wa, mut wb) = (worst(a), worst(b));
         for _ in 0..40 {
-            let (a, b) = (hi - ratio * (hi - lo), lo + ratio * (hi - lo));
-            if worst(a) <= worst(b) {
-                hi = b;
+            if wa <= wb {
+                (hi, b, wb) = (b, a, wa);
+                a = hi - ratio * (hi - lo);
+                wa = worst(a);
             } else {
-                lo = a;
+                (lo, a, wa) = (a, b, wb);
+                b = lo + ratio * (hi - lo);
+                wb = worst(b);
             }
         }
-        let sigma =
-            [best, 0.5 * (lo + hi)].into_iter().min_by(|a, b| worst(*a).total_cmp(&worst(*b)));
-        errors(sigma.unwrap_or(best))
+        best_of(&[best, 0.5 * (lo + hi)])
     }
 
     /// The IK solutions of `x` within the joint limits, the one nearest to `near` first.
@@ -633,34 +665,12 @@ struct Tree {
     nodes: Vec<Node>,
 }
 
-enum Extension {
-    Reached(usize),
-    Advanced(usize),
-    Trapped,
-}
-
-impl Extension {
-    fn node(self) -> Option<usize> {
-        match self {
-            Extension::Reached(i) | Extension::Advanced(i) => Some(i),
-            Extension::Trapped => None,
-        }
-    }
-}
-
 impl Tree {
     /// The node nearest to `q` in joint space. The chart alone cannot tell IK branches
     /// apart: two nodes at one chart point on different branches are far apart in joints, and
     /// no edge joins them without a jump.
     fn nearest(&self, q: &JointVector) -> usize {
-        let mut best = (0, Real::INFINITY);
-        for (i, n) in self.nodes.iter().enumerate() {
-            let d = (n.q - q).norm_squared();
-            if d < best.1 {
-                best = (i, d);
-            }
-        }
-        best.0
+        nearest(self.nodes.iter().map(|n| &n.q), q)
     }
 
     /// One step of at most `step` (chart length) from node `near` towards `target`.

@@ -366,10 +366,39 @@ struct Tree {
     nodes: Vec<Node>,
 }
 
-enum Extension {
+/// The outcome of one step of a tree towards a target.
+pub(crate) enum Extension {
+    /// The target was reached: the new node.
     Reached(usize),
+    /// A step towards it was taken: the new node.
     Advanced(usize),
+    /// The step was blocked.
     Trapped,
+}
+
+impl Extension {
+    /// The new node, if any.
+    pub(crate) fn node(self) -> Option<usize> {
+        match self {
+            Extension::Reached(i) | Extension::Advanced(i) => Some(i),
+            Extension::Trapped => None,
+        }
+    }
+}
+
+/// The index of the configuration nearest to `q` (Euclidean in joint space); 0 for none.
+pub(crate) fn nearest<'a>(
+    configurations: impl Iterator<Item = &'a JointVector>,
+    q: &JointVector,
+) -> usize {
+    let mut best = (0, Real::INFINITY);
+    for (i, c) in configurations.enumerate() {
+        let d = (c - q).norm_squared();
+        if d < best.1 {
+            best = (i, d);
+        }
+    }
+    best.0
 }
 
 impl Tree {
@@ -378,14 +407,7 @@ impl Tree {
     }
 
     fn nearest(&self, q: &JointVector) -> usize {
-        let mut best = (0, Real::INFINITY);
-        for (i, n) in self.nodes.iter().enumerate() {
-            let d = (n.q - q).norm_squared();
-            if d < best.1 {
-                best = (i, d);
-            }
-        }
-        best.0
+        nearest(self.nodes.iter().map(|n| &n.q), q)
     }
 
     /// One step from the nearest node towards `target`, a new configuration or a node of the
@@ -409,10 +431,7 @@ impl Tree {
     }
 
     fn extend(&mut self, target: &JointVector, space: &mut Space) -> Option<usize> {
-        match self.step(target, true, space) {
-            Extension::Reached(i) | Extension::Advanced(i) => Some(i),
-            Extension::Trapped => None,
-        }
+        self.step(target, true, space).node()
     }
 
     /// Steps towards `target` until it is reached (its node) or blocked.
