@@ -104,12 +104,12 @@ fn tasks(c: &mut Criterion) {
     group.finish();
 }
 
-/// The Panda sphere cage of ../shared/bench/panda_sphere_cage.json: the first 10 instances
+/// The Panda sphere cage of tests/data/panda_sphere_cage.json: the first 10 instances
 /// per iteration (divide by 10 for one).
 fn rrt(c: &mut Criterion) {
     use a2ml::solve::rrt::{RrtOptions, rrt_connect};
-    let text = std::fs::read_to_string(path("../shared/bench/panda_sphere_cage.json"))
-        .expect("the shared benchmark file is beside");
+    let text = std::fs::read_to_string(path("tests/data/panda_sphere_cage.json"))
+        .expect("tests/data/panda_sphere_cage.json is in the repository");
     let data: serde_json::Value = serde_json::from_str(&text).expect("json");
     let vector = |v: &serde_json::Value| -> Vec<Real> {
         v.as_array().expect("array").iter().map(|x| x.as_f64().expect("number")).collect()

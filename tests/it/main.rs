@@ -13,6 +13,7 @@ mod output;
 mod plan;
 mod profile;
 mod push_box;
+mod repository;
 mod robots;
 mod rrt;
 mod segments;

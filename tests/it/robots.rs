@@ -1,5 +1,5 @@
 //! The shipped robot models load and have the structure of
-//! ../shared/robots-ref/README.md.
+//! robots/README.md.
 
 use crate::common::load;
 use a2ml::math::Vector3;
@@ -67,7 +67,7 @@ fn human_arm_uses_the_wrist_joint_centre() {
     let human = load("human_arm");
     let st = &human.structure;
     assert!(st.shoulder_spherical && !st.wrist_spherical && !st.is_srs);
-    // U-joint centre and shoulder in the z-up frame (robots-ref README).
+    // U-joint centre and shoulder in the z-up frame (robots/README.md).
     let w = st.wrist_zero + st.shoulder_in_base_link;
     assert!((w - Vector3::new(0.00078, -0.2001, -0.16362)).norm() < 1e-4, "{w:?}");
 }

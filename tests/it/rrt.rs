@@ -11,7 +11,7 @@ use a2ml::solve::rrt::{RrtError, RrtOptions, RrtPath, rrt_connect, time_paramete
 
 use crate::common;
 
-/// The Panda caged by 14 spheres (../shared/bench/panda_sphere_cage.json, instance `k`), in
+/// The Panda caged by 14 spheres (tests/data/panda_sphere_cage.json, instance `k`), in
 /// {b}: the file's frame is the URDF root, S is 0.333 m above it.
 fn sphere_cage(k: usize) -> (JointVector, JointVector, CollisionScene) {
     let (start, goal, spheres) = cage_spheres(k);
@@ -20,8 +20,9 @@ fn sphere_cage(k: usize) -> (JointVector, JointVector, CollisionScene) {
 
 /// The start, goal and spheres of [`sphere_cage`].
 fn cage_spheres(k: usize) -> (JointVector, JointVector, Vec<Obstacle>) {
-    let path = format!("{}/../shared/bench/panda_sphere_cage.json", env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(&path).expect("the shared benchmark file is beside");
+    let path = format!("{}/tests/data/panda_sphere_cage.json", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path)
+        .expect("tests/data/panda_sphere_cage.json is in the repository");
     let data: serde_json::Value = serde_json::from_str(&text).expect("json");
     let vector = |v: &serde_json::Value| -> Vec<Real> {
         v.as_array().expect("array").iter().map(|x| x.as_f64().expect("number")).collect()
