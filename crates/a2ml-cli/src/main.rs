@@ -1,12 +1,14 @@
 //! The `a2ml` command line: parses the arguments, runs the subcommand and
 //! turns the outcome into an exit code (0 success, 1 I/O error, 2 invalid
-//! input, 3 a goal missed, 4 planning failed; see [`error::CliError`]).
+//! input, 3 a goal missed, 4 planning failed; see [`error::CliError`]; 128 +
+//! the signal's number when interrupted, see [`signals`]).
 //! Everything else lives in [`commands`] and the core library.
 
 mod args;
 mod commands;
 mod error;
 mod output;
+mod signals;
 
 use std::io::Write;
 use std::process::ExitCode;
@@ -16,7 +18,9 @@ use clap::Parser;
 fn main() -> ExitCode {
     // clap prints its own usage errors and exits with code 2.
     let cli = args::Cli::parse();
-    match commands::run(cli) {
+    let result =
+        signals::Temporaries::install().and_then(|temporaries| commands::run(cli, &temporaries));
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
             // Nothing sensible is left to do if stderr itself is closed.

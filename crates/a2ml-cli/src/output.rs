@@ -1,10 +1,11 @@
 //! Helpers the commands share for presenting results: conversions to plain
-//! arrays for JSON, number formatting and aligned plain-text tables, and
-//! writing to stdout and stderr.
+//! arrays for JSON, number formatting and aligned plain-text tables,
+//! writing to stdout and stderr, and the checks on output paths.
 //!
 //! Vectors are `[x, y, z]`, quaternions `[w, x, y, z]` with w ≥ 0.
 
 use std::io::Write;
+use std::path::Path;
 
 use a2ml_core::math::{Real, Rotation3, UnitQuaternion, Vector3};
 
@@ -257,6 +258,62 @@ pub fn report(text: &str) {
 /// Writes `warning: <message>` to stderr.
 pub fn warn(message: &str) {
     let _ = writeln!(std::io::stderr(), "warning: {message}");
+}
+
+/// Refuses, before any work, an output path that is not a regular file (a folder, device,
+/// FIFO, socket or symbolic link) or whose folder does not exist.
+///
+/// # Errors
+/// [`CliError::Input`] for a path that is not a regular file, [`CliError::Io`] for a missing
+/// folder or a path that cannot be examined.
+pub fn check_output(path: &Path) -> Result<(), CliError> {
+    match a2ml_core::output::refused_kind(path) {
+        Ok(Some(kind)) => {
+            return Err(CliError::Input(format!(
+                "cannot write {}: it is {kind}, and outputs replace only regular files",
+                path.display()
+            )));
+        }
+        Ok(None) => {}
+        Err(e) => return Err(CliError::Io(e.to_string())),
+    }
+    match path.parent() {
+        Some(folder) if !folder.as_os_str().is_empty() && !folder.is_dir() => Err(CliError::Io(
+            format!("cannot write {}: there is no folder {}", path.display(), folder.display()),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Refuses an output path that is the same file as one of the run's inputs (same device and
+/// inode, links resolved), which writing the output would destroy.
+///
+/// # Errors
+/// [`CliError::Input`] naming the output and the input.
+pub fn check_not_an_input(output: &Path, inputs: &[&Path]) -> Result<(), CliError> {
+    let Ok(written) = std::fs::metadata(output) else { return Ok(()) };
+    for input in inputs {
+        if std::fs::metadata(input).is_ok_and(|read| same_file(&written, &read)) {
+            return Err(CliError::Input(format!(
+                "cannot write {}: it is the input {}",
+                output.display(),
+                input.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(unix)]
+fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    a.dev() == b.dev() && a.ino() == b.ino()
+}
+
+#[cfg(not(unix))]
+fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata) -> bool {
+    // Without inode numbers: the same size and modification time is the best available.
+    a.len() == b.len() && a.modified().ok() == b.modified().ok()
 }
 
 #[cfg(test)]

@@ -15,18 +15,19 @@ use a2ml_core::language::{self, Task};
 use crate::args::{Cli, Commands};
 use crate::error::CliError;
 use crate::output;
+use crate::signals::Temporaries;
 
-/// Runs the subcommand the command line names.
+/// Runs the subcommand the command line names; outputs are staged through `temporaries`.
 ///
 /// # Errors
 /// The subcommand's [`CliError`].
-pub fn run(cli: Cli) -> Result<(), CliError> {
+pub fn run(cli: Cli, temporaries: &Temporaries) -> Result<(), CliError> {
     match cli.command {
         Commands::Robot(args) => robot::run(&args),
         Commands::Check(args) => check::run(&args),
         Commands::Fmt(args) => fmt::run(&args),
         Commands::Explain(args) => explain::run(&args),
-        Commands::Plan(args) => plan::run(&args),
+        Commands::Plan(args) => plan::run(&args, temporaries),
     }
 }
 

@@ -14,11 +14,12 @@ use clap::builder::{PossibleValuesParser, TypedValueParser};
 use a2ml_core::Robot;
 use a2ml_core::language::{SolverChoice, Task, Variable};
 use a2ml_core::math::Real;
-use a2ml_core::output::{self as files, OutputError};
+use a2ml_core::output::{self as files, OutputError, Staged};
 use a2ml_core::solve::{self, Plan, PlanOptions, Progress, SegmentReport, SolveError, Tolerance};
 
 use crate::error::CliError;
 use crate::output::{self, COARSE, Table, deg, num};
+use crate::signals::Temporaries;
 
 /// Decimals for durations (s).
 const SECONDS: usize = 3;
@@ -35,11 +36,15 @@ Examples:
   a2ml plan task.a2ml --solver qp --rate 250 --seed 7
 
 Without -o, --csv or --json the MCAP file goes to <FILE stem>.mcap in the
-current folder. Every file is written to a temporary file and renamed, so a
-failed run leaves no partial file.
+current folder. Outputs replace only regular files, never a task or robot
+file of the run: a folder, device, FIFO or symbolic link is refused. Every
+output is written to a temporary file beside it, and all are renamed once
+every one is complete, so a failed or interrupted run (SIGINT, SIGTERM,
+SIGHUP: exit 130, 143, 129) leaves the old files as they were and no
+temporary file.
 
-Exit codes: 0 success, 1 a file cannot be read or written, 2 the task or an
-option is not valid or the task cannot be decomposed, 3 a goal is missed
+Exit codes: 0 success, 1 a file cannot be read or written, 2 the task, an
+option or an output path is not valid or the task cannot be decomposed, 3 a goal is missed
 beyond tolerance (the files are written all the same), 4 the solver failed
 on a segment (nothing is written).")]
 pub struct PlanArgs {
@@ -105,14 +110,23 @@ enum Format {
 /// first), an unusable robot, a task that does not decompose or a solver that
 /// does not exist yet; [`CliError::Planning`] when a segment's solve fails;
 /// [`CliError::Missed`] when the plan, written all the same, misses a goal.
-pub fn run(args: &PlanArgs) -> Result<(), CliError> {
+pub fn run(args: &PlanArgs, temporaries: &Temporaries) -> Result<(), CliError> {
     let outputs = outputs(args);
-    for (_, path) in &outputs {
-        check_folder(path)?;
+    for (k, (_, path)) in outputs.iter().enumerate() {
+        output::check_output(path)?;
+        if outputs[..k].iter().any(|(_, earlier)| earlier == path) {
+            return Err(CliError::Input(format!(
+                "{} is given as two outputs; each output needs a file of its own",
+                path.display()
+            )));
+        }
     }
     let (mut task, source) = super::load_task(&args.file)?;
     if let Some(seed) = args.seed {
         task.settings.seed = seed;
+    }
+    for (_, path) in &outputs {
+        output::check_not_an_input(path, &[&args.file, &task.robot])?;
     }
     let robot = Robot::from_urdf_file(&task.robot)?;
     let options = PlanOptions { solver: args.solver, rate: args.rate, ..PlanOptions::default() };
@@ -129,8 +143,16 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     }
     let tolerance = options.qp.tolerance;
     output::print(&summary(&args.file, &robot, &plan, &tolerance, planning_time))?;
+    // Every output to its temporary file first, then all renamed: a run that fails on one
+    // output leaves the others as they were.
+    let mut staged = Vec::with_capacity(outputs.len());
     for (format, path) in &outputs {
-        write(*format, path, &robot, &task, &source, &plan).map_err(output_error)?;
+        let mut file = temporaries.stage(path).map_err(output_error)?;
+        write(*format, &mut file, &robot, &task, &source, &plan).map_err(output_error)?;
+        staged.push(file);
+    }
+    temporaries.commit_all(staged).map_err(output_error)?;
+    for (_, path) in &outputs {
         output::print(&format!("wrote  {}\n", path.display()))?;
     }
 
@@ -168,38 +190,29 @@ fn outputs(args: &PlanArgs) -> Vec<(Format, PathBuf)> {
     outputs
 }
 
-/// Fails early, before a long plan, when an output's folder does not exist.
-///
-/// # Errors
-/// [`CliError::Io`] naming the output and its folder.
-fn check_folder(path: &Path) -> Result<(), CliError> {
-    match path.parent() {
-        Some(folder) if !folder.as_os_str().is_empty() && !folder.is_dir() => Err(CliError::Io(
-            format!("cannot write {}: there is no folder {}", path.display(), folder.display()),
-        )),
-        _ => Ok(()),
-    }
-}
-
 fn write(
     format: Format,
-    path: &Path,
+    staged: &mut Staged,
     robot: &Robot,
     task: &Task,
     source: &str,
     plan: &Plan,
 ) -> Result<(), OutputError> {
     match format {
-        Format::Mcap => files::write_mcap(path, robot, task, source, plan),
-        Format::Csv => files::write_csv(path, robot, plan),
-        Format::Json => files::write_json(path, robot, task, plan),
+        Format::Mcap => files::fill_mcap(staged, robot, task, source, plan),
+        Format::Csv => files::fill_csv(staged, robot, plan),
+        Format::Json => files::fill_json(staged, robot, task, plan),
     }
 }
 
 /// An output that cannot be written is an I/O failure, whatever the cause:
 /// an encoding failure would be a bug, but still a file not written.
+/// A path that is not a regular file is invalid input.
 fn output_error(error: OutputError) -> CliError {
-    CliError::Io(error.to_string())
+    match error {
+        OutputError::NotRegularFile { .. } => CliError::Input(error.to_string()),
+        _ => CliError::Io(error.to_string()),
+    }
 }
 
 /// The exit code of each way planning fails: the input (2) or the solver (4).

@@ -3,6 +3,7 @@
 
 mod explain;
 mod language;
+mod outputs;
 mod plan;
 mod robot;
 

@@ -214,7 +214,7 @@ fn bad_rate_exits_2() {
 }
 
 #[test]
-fn unwritable_output_exits_1_and_leaves_no_file() {
+fn unwritable_output_exits_and_leaves_no_file() {
     let dir = scratch("plan", "unwritable_output");
     let task = example_path("construct_path_by.a2ml");
 
@@ -226,12 +226,13 @@ fn unwritable_output_exits_1_and_leaves_no_file() {
     assert!(err.starts_with(&format!("error: cannot write {missing}: there is no folder ")));
     assert!(stdout(&output).is_empty(), "nothing planned");
 
-    // A folder in the way is found when the plan is renamed into place.
+    // A folder in the way is found before planning too, and is invalid input.
     let folder = path_in(&dir, "taken.mcap");
     fs::create_dir(&folder).expect("folder");
     let output = a2ml(&["plan", &task, "-o", &folder]);
-    assert_eq!(output.status.code(), Some(1), "stderr: {}", stderr(&output));
-    assert!(stderr(&output).starts_with(&format!("error: cannot write {folder}: ")));
+    assert_eq!(output.status.code(), Some(2), "stderr: {}", stderr(&output));
+    assert!(stderr(&output).starts_with(&format!("error: cannot write {folder}: it is a folder")));
+    assert!(stdout(&output).is_empty(), "nothing planned");
     assert_eq!(listing(&dir), ["taken.mcap"], "no temporary file left");
     assert!(listing(Path::new(&folder)).is_empty());
 }

@@ -3,7 +3,8 @@
 //!
 //! Entry points: [`write_mcap`], [`write_csv`], [`write_json`]. Every writer goes through a
 //! temporary file beside the target, renamed on success and removed on failure, so a failed
-//! run never leaves a partial file. Positions are in {b}, times in the plan's seconds (MCAP:
+//! run never leaves a partial file; several outputs can be [`Staged`] first and committed
+//! together ([`fill_mcap`], [`fill_csv`], [`fill_json`]). Only regular files are replaced. Positions are in {b}, times in the plan's seconds (MCAP:
 //! nanoseconds from the plan's time 0). mcap enters the crate here only.
 
 mod atomic;
@@ -17,6 +18,8 @@ mod schemas;
 mod tests;
 
 use std::path::Path;
+
+pub use atomic::{Staged, refused_kind};
 
 use crate::language::Task;
 use crate::math::Real;
@@ -58,6 +61,15 @@ pub enum OutputError {
         /// The OS message.
         message: String,
     },
+    /// The path is a folder, device, FIFO, socket or symbolic link, which an output never
+    /// replaces.
+    #[error("cannot write {path}: it is {kind}, and outputs replace only regular files")]
+    NotRegularFile {
+        /// The path as given.
+        path: String,
+        /// What is there: "a folder", "a device", "a FIFO", "a socket", "a symbolic link".
+        kind: &'static str,
+    },
     /// The MCAP writer failed to encode a record.
     #[error("cannot encode the MCAP file {path}: {message}")]
     Mcap {
@@ -91,6 +103,41 @@ pub fn write_mcap(
     plan: &Plan,
 ) -> Result<(), OutputError> {
     atomic::write_atomically(path, |out| mcap_file::write(out, robot, task, source, plan))
+}
+
+/// [`write_mcap`] into a staged temporary file, to be committed with the run's other outputs.
+///
+/// # Errors
+/// As [`write_mcap`]; the staged file is then useless and is removed when dropped.
+pub fn fill_mcap(
+    staged: &mut Staged,
+    robot: &Robot,
+    task: &Task,
+    source: &str,
+    plan: &Plan,
+) -> Result<(), OutputError> {
+    staged.fill(|out| mcap_file::write(out, robot, task, source, plan))
+}
+
+/// [`write_csv`] into a staged temporary file.
+///
+/// # Errors
+/// As [`write_csv`].
+pub fn fill_csv(staged: &mut Staged, robot: &Robot, plan: &Plan) -> Result<(), OutputError> {
+    staged.fill(|out| csv::write(out, robot, plan))
+}
+
+/// [`write_json`] into a staged temporary file.
+///
+/// # Errors
+/// As [`write_json`].
+pub fn fill_json(
+    staged: &mut Staged,
+    robot: &Robot,
+    task: &Task,
+    plan: &Plan,
+) -> Result<(), OutputError> {
+    staged.fill(|out| json::write(out, robot, task, plan))
 }
 
 /// Writes the joint trajectory as CSV: `t`, then `<joint>_pos` and `<joint>_vel` per joint,
