@@ -65,6 +65,9 @@ pub struct PlanArgs {
     /// Seed of the randomised solvers, overriding the task's `settings { seed }`.
     #[arg(long, value_name = "N")]
     pub seed: Option<u64>,
+    /// Which chain of the URDF, and where its capsules come from.
+    #[command(flatten)]
+    pub arm: crate::args::ArmArgs,
 }
 
 /// `--solver`: one of [`SolverChoice::NAMES`], listed in `--help`.
@@ -114,7 +117,8 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
     if let Some(seed) = args.seed {
         task.settings.seed = seed;
     }
-    let robot = Robot::from_urdf_file(&task.robot)?;
+    let robot_options = args.arm.options(task.robot_base.as_deref(), task.robot_tip.as_deref())?;
+    let robot = Robot::from_urdf_file_with(&task.robot, &robot_options)?;
     let options = PlanOptions { solver: args.solver, rate: args.rate, ..PlanOptions::default() };
 
     let started = Instant::now();
@@ -208,6 +212,7 @@ fn solve_error(file: &Path, error: SolveError) -> CliError {
     match error {
         SolveError::Decompose(_)
         | SolveError::InvalidRate { .. }
+        | SolveError::NoArmGeometry { .. }
         | SolveError::UnsupportedSolver { .. } => CliError::Input(message),
         SolveError::Reference { .. }
         | SolveError::Qp { .. }
