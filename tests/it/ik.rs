@@ -128,3 +128,69 @@ fn mapping_agrees_with_the_arm_on_analytic_arms() {
         }
     }
 }
+
+/// Round trips q -> CPSA -> IK on the third-party arms, from a start 0.3 rad
+/// off in every joint: the rate that reaches the state within limits, and,
+/// on analytic arms, the rate whose branches include q.
+fn third_party_round_trips(samples: usize) -> Vec<(&'static str, &'static str, Real, Real)> {
+    use a2ml::math::DOF;
+    use rand::RngExt;
+    let mut out = Vec::new();
+    for (name, robot) in crate::robots::third_party() {
+        let mut rng = rng(21);
+        let (mut reached, mut found) = (0usize, 0usize);
+        for _ in 0..samples {
+            let (q, pose) = regular_q(&robot, &mut rng, 0.05);
+            let target = cpsa_state(&robot, &pose).expect("regular");
+            let mut near = q;
+            for i in 0..DOF {
+                let l = robot.joints[i].limits;
+                near[i] = (q[i] + rng.random_range(-0.3..0.3)).clamp(l.lower, l.upper);
+            }
+            let Ok(solutions) = ik_cpsa(&robot, &target, Some(&near)) else { continue };
+            let good = solutions.iter().all(|s| {
+                let state = cpsa_state(&robot, &arm_pose(&robot, s)).expect("regular");
+                robot.within_limits(s, 1e-9) && cpsa_error(&state, &target) < 1e-8
+            });
+            reached += usize::from(good && !solutions.is_empty());
+            found += usize::from(contains(&solutions, &q));
+        }
+        let kind = match (robot.has_analytic_ik(), robot.structure.idealisation > 1e-12) {
+            (true, false) => "analytic",
+            (true, true) => "analytic + Newton polish",
+            (false, _) => "Newton from the spherical approximation",
+        };
+        let n = samples as Real;
+        out.push((name, kind, reached as Real / n, found as Real / n));
+    }
+    out
+}
+
+#[test]
+fn third_party_ik_round_trips_succeed() {
+    for (name, kind, reached, found) in third_party_round_trips(400) {
+        println!("{name}: {kind}: reached {:.2} %, original among branches {:.2} %", 100.0 * reached, 100.0 * found);
+        assert!(reached >= 0.995, "{name} ({kind}): round trips reach only {reached}");
+        if kind.starts_with("analytic") {
+            // Nearest first holds only if q itself is a candidate, 2π shifts included.
+            assert!(found >= 0.995, "{name}: the original configuration is a branch in {found}");
+        }
+    }
+}
+
+#[test]
+fn newton_ik_respects_its_budget_and_deadline() {
+    let (_, robot) = crate::robots::third_party()
+        .into_iter()
+        .find(|(_, r)| !r.has_analytic_ik())
+        .expect("an arm with offsets");
+    let mut target = cpsa_state(&robot, &arm_pose(&robot, &robot.middle())).expect("regular");
+    // Far out of reach: Newton can only give up.
+    target.pw *= 10.0;
+    let budget = IkOptions { max_total_iterations: 50, ..IkOptions::default() };
+    let err = ik_cpsa_with(&robot, &target, None, &budget).unwrap_err();
+    assert!(matches!(err, KinematicsError::NoConvergence { starts, .. } if starts <= 50), "{err:?}");
+    let past = IkOptions { deadline: Some(std::time::Instant::now()), ..IkOptions::default() };
+    let err = ik_cpsa_with(&robot, &target, None, &past).unwrap_err();
+    assert!(matches!(err, KinematicsError::NoConvergence { .. }), "{err:?}");
+}

@@ -44,3 +44,61 @@ pub enum Commands {
     /// Plan a task's motion and write it as MCAP (for Foxglove), CSV or JSON.
     Plan(PlanArgs),
 }
+
+/// How `robot`, `explain` and `plan` read the arm from its URDF.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct ArmArgs {
+    /// Base link of the arm's chain [default: the task's `robot ... base`,
+    /// else the root of the unique 7-joint chain].
+    #[arg(long, value_name = "LINK")]
+    pub base: Option<String>,
+    /// Tip link of the arm's chain [default: the task's `robot ... tip`,
+    /// else the last link of the unique 7-joint chain].
+    #[arg(long, value_name = "LINK")]
+    pub tip: Option<String>,
+    /// A folder searched for `package://` meshes (a package, or a folder of
+    /// packages); repeatable, searched before A2ML_PACKAGE_PATH and
+    /// ROS_PACKAGE_PATH.
+    #[arg(long = "package-path", value_name = "DIR")]
+    pub package_path: Vec<std::path::PathBuf>,
+    /// Radius (m) of the skeleton capsules that cover parts of the arm
+    /// without usable URDF geometry; 0 leaves them uncovered [default: 0.06].
+    #[arg(long, value_name = "M")]
+    pub skeleton_radius: Option<f64>,
+}
+
+impl ArmArgs {
+    /// The robot options: these arguments over the task's `base`/`tip`, and
+    /// the package path with the environment's folders after `--package-path`.
+    ///
+    /// # Errors
+    /// A message when the skeleton radius is negative or not finite.
+    pub fn options(
+        &self,
+        task_base: Option<&str>,
+        task_tip: Option<&str>,
+    ) -> Result<a2ml_core::RobotOptions, crate::error::CliError> {
+        let mut options = a2ml_core::RobotOptions {
+            base: self.base.clone().or(task_base.map(str::to_owned)),
+            tip: self.tip.clone().or(task_tip.map(str::to_owned)),
+            ..a2ml_core::RobotOptions::default()
+        };
+        let geometry = &mut options.geometry;
+        geometry.package_path = self.package_path.clone();
+        for variable in ["A2ML_PACKAGE_PATH", "ROS_PACKAGE_PATH"] {
+            if let Some(value) = std::env::var_os(variable) {
+                geometry.package_path.extend(std::env::split_paths(&value));
+            }
+        }
+        match self.skeleton_radius {
+            Some(r) if !(r.is_finite() && r >= 0.0) => {
+                return Err(crate::error::CliError::Input(format!(
+                    "--skeleton-radius {r}: it must be a finite length of 0 m or more"
+                )));
+            }
+            Some(r) => geometry.skeleton_radius = (r > 0.0).then_some(r),
+            None => {}
+        }
+        Ok(options)
+    }
+}

@@ -47,6 +47,9 @@ pub struct ExplainArgs {
     /// Print JSON instead of the tree.
     #[arg(long)]
     pub json: bool,
+    /// Which chain of the URDF, and where its capsules come from.
+    #[command(flatten)]
+    pub arm: crate::args::ArmArgs,
 }
 
 /// Runs `a2ml explain`.
@@ -57,7 +60,8 @@ pub struct ExplainArgs {
 /// stderr first), the robot is unusable, or the decomposition fails.
 pub fn run(args: &ExplainArgs) -> Result<(), CliError> {
     let (task, _) = super::load_task(&args.file)?;
-    let robot = Robot::from_urdf_file(&task.robot)?;
+    let options = args.arm.options(task.robot_base.as_deref(), task.robot_tip.as_deref())?;
+    let robot = Robot::from_urdf_file_with(&task.robot, &options)?;
     let decomposition = decompose::decompose(&robot, &task, &DecomposeOptions::default())
         .map_err(|e| CliError::Input(format!("{}: {e}", args.file.display())))?;
     let report = ExplainReport::new(&args.file, &robot, &task, &decomposition);

@@ -70,6 +70,9 @@ pub struct PlanArgs {
     /// Seed of the randomised solvers, overriding the task's `settings { seed }`.
     #[arg(long, value_name = "N")]
     pub seed: Option<u64>,
+    /// Which chain of the URDF, and where its capsules come from.
+    #[command(flatten)]
+    pub arm: crate::args::ArmArgs,
 }
 
 /// `--solver`: one of [`SolverChoice::NAMES`], listed in `--help`.
@@ -128,7 +131,8 @@ pub fn run(args: &PlanArgs, temporaries: &Temporaries) -> Result<(), CliError> {
     for (_, path) in &outputs {
         output::check_not_an_input(path, &[&args.file, &task.robot])?;
     }
-    let robot = Robot::from_urdf_file(&task.robot)?;
+    let robot_options = args.arm.options(task.robot_base.as_deref(), task.robot_tip.as_deref())?;
+    let robot = Robot::from_urdf_file_with(&task.robot, &robot_options)?;
     let options = PlanOptions { solver: args.solver, rate: args.rate, ..PlanOptions::default() };
 
     let started = Instant::now();
@@ -221,6 +225,7 @@ fn solve_error(file: &Path, error: SolveError) -> CliError {
     match error {
         SolveError::Decompose(_)
         | SolveError::InvalidRate { .. }
+        | SolveError::NoArmGeometry { .. }
         | SolveError::UnsupportedSolver { .. } => CliError::Input(message),
         SolveError::Reference { .. }
         | SolveError::Qp { .. }

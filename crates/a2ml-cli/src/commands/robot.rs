@@ -12,8 +12,8 @@ use serde::Serialize;
 
 use a2ml_core::kinematics::{self, KinematicsError};
 use a2ml_core::math::{DOF, JointVector, Real, Rotation3, Vector3};
-use a2ml_core::robot::{Capsule, LinkRole};
-use a2ml_core::{Robot, RobotOptions};
+use a2ml_core::robot::{Capsule, CapsuleSource, LinkRole};
+use a2ml_core::Robot;
 
 use crate::error::CliError;
 use crate::output::{
@@ -38,12 +38,9 @@ the shoulder centre S. Quaternions are printed w, x, y, z.")]
 pub struct RobotArgs {
     /// The URDF file of the arm.
     pub urdf: PathBuf,
-    /// Base link of the chain [default: the root of the unique 7-joint chain].
-    #[arg(long, value_name = "LINK")]
-    pub base: Option<String>,
-    /// Tip link of the chain [default: the last link of the unique 7-joint chain].
-    #[arg(long, value_name = "LINK")]
-    pub tip: Option<String>,
+    /// Which chain, and where its capsules come from.
+    #[command(flatten)]
+    pub arm: crate::args::ArmArgs,
     /// Also show the arm's state at this configuration: seven joint values,
     /// comma separated, in radians (degrees with --deg).
     #[arg(
@@ -95,8 +92,7 @@ pub fn parse_configuration(text: &str) -> Result<Configuration, String> {
 /// [`CliError::Io`] when the URDF cannot be read, [`CliError::Input`] when it
 /// holds no usable 7-joint arm or a link name is unknown.
 pub fn run(args: &RobotArgs) -> Result<(), CliError> {
-    let options =
-        RobotOptions { base: args.base.clone(), tip: args.tip.clone(), ..RobotOptions::default() };
+    let options = args.arm.options(None, None)?;
     let robot = Robot::from_urdf_file_with(&args.urdf, &options)?;
     let q = args.at.map(|Configuration(values)| {
         JointVector::from_fn(|i, _| if args.deg { values[i].to_radians() } else { values[i] })
@@ -185,6 +181,8 @@ pub struct CapsuleReport {
     pub radius: Real,
     /// Length of the segment, caps excluded (m).
     pub length: Real,
+    /// Where it came from: a URDF shape, a box, a mesh or the skeleton.
+    pub source: CapsuleSource,
 }
 
 /// The arm's state at one configuration, in {b}.
@@ -298,6 +296,7 @@ impl CapsuleReport {
             role: capsule.role,
             radius: capsule.radius,
             length: capsule.length(),
+            source: capsule.source,
         }
     }
 }
@@ -355,7 +354,7 @@ impl RobotReport {
     /// The report on `robot`, with its state at `q` when given.
     pub fn new(robot: &Robot, q: Option<&JointVector>) -> Self {
         let s = &robot.structure;
-        let warnings = q.map_or_else(Vec::new, |q| {
+        let limit_warnings = q.map_or_else(Vec::new, |q| {
             robot
                 .joints
                 .iter()
@@ -407,7 +406,12 @@ impl RobotReport {
             },
             capsules: robot.capsules.iter().map(CapsuleReport::new).collect(),
             state: q.map(|q| StateReport::new(robot, q)),
-            warnings,
+            warnings: robot
+                .geometry_warnings
+                .iter()
+                .map(|w| format!("collision geometry: {w}"))
+                .chain(limit_warnings)
+                .collect(),
         }
     }
 
@@ -464,12 +468,11 @@ impl RobotReport {
         t.render(&mut out);
 
         let mut capsules =
-            Table::with_header(["capsule", "link", "role", "radius (m)", "length (m)"])
-                .left_columns(3);
+            Table::with_header(["capsule", "link", "role", "source", "radius (m)", "length (m)"])
+                .left_columns(4);
         capsules.title("capsules");
         if self.capsules.is_empty() {
-            capsules
-                .line("none (the chain's links have no cylinder, capsule or sphere collisions)");
+            capsules.line("none (no usable URDF geometry, and skeleton capsules are off)");
         }
         for c in &self.capsules {
             capsules.row(
@@ -477,6 +480,7 @@ impl RobotReport {
                 [
                     c.link.clone(),
                     c.role.as_str().to_owned(),
+                    c.source.as_str().to_owned(),
                     num(c.radius, FINE),
                     num(c.length, FINE),
                 ],

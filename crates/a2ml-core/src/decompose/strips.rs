@@ -273,6 +273,8 @@ mod tests {
         Task {
             name: "t".into(),
             robot: Default::default(),
+            robot_base: None,
+            robot_tip: None,
             start: None,
             scene: Vec::new(),
             settings: Default::default(),

@@ -4,8 +4,13 @@
 //! point are solved in closed form, elbow offsets allowed: the triangle
 //! S-E-W is rigid but for its angle at E, so |Pw| fixes q4 (Paden-Kahan
 //! subproblem 3), the shoulder's three axes realise the triangle's pose
-//! (subproblems 2 then 1) and the wrist's three axes realise Ow. Other arms
-//! use damped Newton on the square 7x7 task Jacobian.
+//! (subproblems 2 then 1) and the wrist's three axes realise Ow. Axes that
+//! meet only within `MEET_TOL_RELATIVE` of the arm's length are solved as if
+//! they met, then polished by Newton on the real chain. Other arms use
+//! Levenberg-Marquardt on the square 7x7 task Jacobian, started from the
+//! closed-form branches of the arm with its shoulder (and wrist) axes moved
+//! through S (and W): the nearest spherical approximation. Every search has
+//! an iteration budget, and callers may add a deadline.
 
 use super::error::{KinematicsError, Singularity};
 use super::fk::arm_pose;
@@ -17,15 +22,23 @@ use crate::math::{
     DOF, JointVector, Matrix3, Matrix7, PI, Real, Rotation3, Vector3, Vector7, reject,
     rotation_about, rotation_log, solve_trig, wrap_angle,
 };
-use crate::robot::Robot;
+use crate::robot::{ArmStructure, Robot};
 
-/// Settings of the numerical IK (arms without a closed form).
+/// Settings of the numerical IK (arms without a closed form, and the polish
+/// of near-analytic ones).
 #[derive(Debug, Clone)]
 pub struct IkOptions {
-    /// Starting points tried: `q_near` first, then a Halton sequence over the limits.
+    /// Starting points tried: `q_near` first, then the closed-form guesses,
+    /// then a Halton sequence over the limits.
     pub max_starts: usize,
     /// Levenberg-Marquardt iterations per start.
     pub max_iterations: usize,
+    /// Levenberg-Marquardt iterations over all starts of one call: the bound
+    /// on its cost (each is one FK and one Jacobian).
+    pub max_total_iterations: usize,
+    /// Wall-clock time after which the search gives up, for callers with a
+    /// time limit; `None` (the default) keeps IK deterministic.
+    pub deadline: Option<std::time::Instant>,
     /// Convergence threshold on the task-space residual norm.
     pub tolerance: Real,
     /// Slack allowed on joint limits (rad).
@@ -34,8 +47,21 @@ pub struct IkOptions {
 
 impl Default for IkOptions {
     fn default() -> Self {
-        Self { max_starts: 64, max_iterations: 200, tolerance: 1e-12, limit_tolerance: 1e-9 }
+        Self {
+            max_starts: 64,
+            max_iterations: 200,
+            max_total_iterations: 3000,
+            deadline: None,
+            tolerance: 1e-12,
+            limit_tolerance: 1e-9,
+        }
     }
+}
+
+/// Residual norm below which a search has converged: the requested
+/// tolerance, or what rounding allows on a metre-sized arm.
+fn converged(options: &IkOptions) -> Real {
+    options.tolerance.max(1e-10)
 }
 
 /// Joint solutions reaching a CPSA state: every branch within the limits,
@@ -64,16 +90,11 @@ pub fn ik_cpsa_with(
     q_near: Option<&JointVector>,
     options: &IkOptions,
 ) -> Result<Vec<JointVector>, KinematicsError> {
-    let hat = cpsa_to_hat(robot, target)?;
-    let near = q_near.copied().unwrap_or_else(|| robot.middle());
-    if robot.has_analytic_ik() {
-        let (elbow, wrist) = hat_points(robot, &hat);
-        let branches = analytic_branches(robot, &elbow, &wrist, &target.ow, &near)?;
-        return select(robot, branches, &near, options.limit_tolerance);
+    if !(target.pw.iter().all(|v| v.is_finite()) && target.swivel.is_finite()) {
+        return Err(KinematicsError::NonFinite { what: "CPSA state" });
     }
-    let (elbow, wrist) = hat_points(robot, &hat);
-    let guesses = || decoupled_guesses(robot, &elbow, &wrist, &target.ow, &near);
-    newton(robot, &near, q_near.is_some(), guesses, options, |q| {
+    let near = q_near.copied().unwrap_or_else(|| robot.middle());
+    let residual = |q: &JointVector| {
         let pose = arm_pose(robot, q);
         let state = cpsa_state(robot, &pose)?;
         let mut e = Vector7::zeros();
@@ -81,7 +102,29 @@ pub fn ik_cpsa_with(
         e.fixed_rows_mut::<3>(3).copy_from(&rotation_log(&(target.ow * state.ow.inverse())));
         e[6] = wrap_angle(target.swivel - state.swivel);
         Ok((e, cpsa_jacobian(robot, &pose)?))
-    })
+    };
+    if robot.has_analytic_ik() {
+        let hat = cpsa_to_hat(robot, target)?;
+        let (elbow, wrist) = hat_points(robot, &hat);
+        let branches = analytic_branches(robot, &elbow, &wrist, &target.ow, &near)?;
+        return polished(robot, branches, &near, options, residual);
+    }
+    // The real reach of an arm with offsets is not the annulus of lu and lf:
+    // only the guesses use it, with the wrist target pulled into it.
+    let guesses = || {
+        let (lu, lf) = (robot.upper_arm_length(), robot.forearm_length());
+        let d = target.pw.norm();
+        let inside = d.clamp((lu - lf).abs() * (1.0 + 1e-9), (lu + lf) * (1.0 - 1e-9));
+        let pulled = CpsaState { pw: target.pw * (inside / d.max(Real::MIN_POSITIVE)), ..*target };
+        cpsa_to_hat(robot, &pulled).map_or_else(
+            |_| Vec::new(),
+            |hat| {
+                let (elbow, wrist) = hat_points(robot, &hat);
+                decoupled_guesses(robot, &elbow, &wrist, &target.ow, &near)
+            },
+        )
+    };
+    newton(robot, &near, q_near.is_some(), guesses, options, residual)
 }
 
 /// Joint solutions reaching a HAT state; as [`ik_cpsa`].
@@ -112,14 +155,7 @@ pub fn ik_hat_with(
         return Err(KinematicsError::NonFinite { what: "HAT state" });
     }
     let near = q_near.copied().unwrap_or_else(|| robot.middle());
-    if robot.has_analytic_ik() {
-        let (elbow, wrist) = hat_points(robot, target);
-        let branches = analytic_branches(robot, &elbow, &wrist, &target.ow, &near)?;
-        return select(robot, branches, &near, options.limit_tolerance);
-    }
-    let (elbow, wrist) = hat_points(robot, target);
-    let guesses = || decoupled_guesses(robot, &elbow, &wrist, &target.ow, &near);
-    newton(robot, &near, q_near.is_some(), guesses, options, |q| {
+    let residual = |q: &JointVector| {
         let pose = arm_pose(robot, q);
         let state = hat_state(&pose)?;
         let mut e = Vector7::zeros();
@@ -128,7 +164,48 @@ pub fn ik_hat_with(
         e[3] = target.elbow_angle - state.elbow_angle;
         e.fixed_rows_mut::<3>(4).copy_from(&rotation_log(&(target.ow * state.ow.inverse())));
         Ok((e, hat_jacobian(&pose)?))
-    })
+    };
+    let (elbow, wrist) = hat_points(robot, target);
+    if robot.has_analytic_ik() {
+        let branches = analytic_branches(robot, &elbow, &wrist, &target.ow, &near)?;
+        return polished(robot, branches, &near, options, residual);
+    }
+    let guesses = || decoupled_guesses(robot, &elbow, &wrist, &target.ow, &near);
+    newton(robot, &near, q_near.is_some(), guesses, options, residual)
+}
+
+/// The analytic branches within limits, nearest first; on an arm whose axes
+/// meet only within tolerance, each polished by Newton on the real chain and
+/// kept if it converges there.
+fn polished<F>(
+    robot: &Robot,
+    branches: Vec<JointVector>,
+    near: &JointVector,
+    options: &IkOptions,
+    residual: F,
+) -> Result<Vec<JointVector>, KinematicsError>
+where
+    F: Fn(&JointVector) -> Result<(Vector7, Matrix7), KinematicsError>,
+{
+    let inside = select(robot, branches, near, options.limit_tolerance)?;
+    if robot.structure.idealisation <= 1e-12 {
+        return Ok(inside);
+    }
+    let mut budget = Budget::new(options);
+    let mut best = Real::INFINITY;
+    let mut out: Vec<JointVector> = Vec::with_capacity(inside.len());
+    for start in inside {
+        let (q, e) = descend(robot, start, &residual, options, &mut budget);
+        best = best.min(e);
+        if e < converged(options) && !out.iter().any(|p| (p - q).amax() < 1e-9) {
+            out.push(q);
+        }
+    }
+    if out.is_empty() {
+        return Err(KinematicsError::NoConvergence { residual: best, starts: budget.starts });
+    }
+    out.sort_by(|a, b| (a - near).norm().total_cmp(&(b - near).norm()));
+    Ok(out)
 }
 
 /// An angle with its sine and cosine, so that rotating by it needs no
@@ -253,7 +330,8 @@ pub(crate) fn analytic_branches(
     ow: &Rotation3,
     near: &JointVector,
 ) -> Result<Vec<JointVector>, KinematicsError> {
-    branches_with_wrist(robot, &robot.structure.wrist_zero, elbow, wrist, ow, near)
+    let s = &robot.structure;
+    branches_with_wrist(robot, s, &s.wrist_zero, elbow, wrist, ow, near)
 }
 
 /// Every q4 that gives the triangle S-E-W the target's shape, with the
@@ -264,7 +342,16 @@ pub(crate) fn triangle_placements(
     elbow: &Vector3,
     wrist: &Vector3,
 ) -> Result<Vec<(Real, Matrix3)>, KinematicsError> {
-    let s = &robot.structure;
+    placements_of(&robot.structure, wrist_zero, elbow, wrist)
+}
+
+/// [`triangle_placements`] for the arm structure `s`.
+fn placements_of(
+    s: &ArmStructure,
+    wrist_zero: &Vector3,
+    elbow: &Vector3,
+    wrist: &Vector3,
+) -> Result<Vec<(Real, Matrix3)>, KinematicsError> {
     let (w, p) = (&s.axes_zero, &s.axis_points_zero);
     let d = wrist.norm();
 
@@ -280,7 +367,7 @@ pub(crate) fn triangle_placements(
         d * d - c0.norm_squared() - v_perp.norm_squared(),
     );
     if q4s.is_empty() {
-        let (lu, lf) = (robot.upper_arm_length(), robot.forearm_length());
+        let (lu, lf) = (s.upper_arm_length, s.forearm_length);
         return Err(KinematicsError::Unreachable {
             distance: d,
             min: (lu - lf).abs(),
@@ -302,16 +389,16 @@ pub(crate) fn triangle_placements(
 /// joints 1-4 are at zero (exact when joints 5-7 do not move W).
 fn branches_with_wrist(
     robot: &Robot,
+    s: &ArmStructure,
     wrist_zero: &Vector3,
     elbow: &Vector3,
     wrist: &Vector3,
     ow: &Rotation3,
     near: &JointVector,
 ) -> Result<Vec<JointVector>, KinematicsError> {
-    let s = &robot.structure;
     let w = &s.axes_zero;
     let mut out = Vec::with_capacity(8);
-    for (q4, r123) in triangle_placements(robot, wrist_zero, elbow, wrist)? {
+    for (q4, r123) in placements_of(s, wrist_zero, elbow, wrist)? {
         // Whatever the shoulder branch, R1 R2 R3 = r123: the wrist's share of
         // Ow is the same for both, so it is split once per q4.
         let r567 = (r123 * rotation_about(&w[3], q4)).transpose()
@@ -321,23 +408,49 @@ fn branches_with_wrist(
         for &[q1, q2, q3] in decompose(&r123, &w[0], &w[1], &w[2], near[0])?.as_slice() {
             for [q5, q6, q7] in wrists.as_slice() {
                 let q = JointVector::from_column_slice(&[q1, q2, q3, q4, *q5, *q6, *q7]);
-                out.push(into_range(robot, q));
+                push_shifts(robot, q, &mut out);
             }
         }
     }
     Ok(out)
 }
 
-/// Moves every angle by ±2π into its joint range where that is possible.
-fn into_range(robot: &Robot, mut q: JointVector) -> JointVector {
+/// Pushes every version of `q` whose angles are moved by multiples of 2π
+/// into their joint ranges (several where a range spans more than a turn,
+/// as on continuous joints); a joint that no shift brings inside keeps the
+/// shift nearest its range, so that the branch can still be reported.
+fn push_shifts(robot: &Robot, q: JointVector, out: &mut Vec<JointVector>) {
+    let first = out.len();
+    out.push(q);
     for (i, joint) in robot.joints.iter().enumerate() {
         let l = &joint.limits;
-        let candidates = [q[i], q[i] - 2.0 * PI, q[i] + 2.0 * PI];
-        let excess = |v: Real| (l.lower - v).max(v - l.upper).max(0.0);
-        q[i] =
-            candidates.into_iter().min_by(|a, b| excess(*a).total_cmp(&excess(*b))).unwrap_or(q[i]);
+        let base = q[i] - 2.0 * PI * ((q[i] - l.lower) / (2.0 * PI)).floor();
+        // base is the smallest shift at or above the lower limit.
+        let values: Vec<Real> = (0..)
+            .map(|k| base + 2.0 * PI * Real::from(k))
+            .take_while(|v| *v <= l.upper + 1e-9)
+            .collect();
+        let values = if values.is_empty() {
+            let excess = |v: Real| (l.lower - v).max(v - l.upper).max(0.0);
+            let nearest =
+                if excess(base - 2.0 * PI) < excess(base) { base - 2.0 * PI } else { base };
+            vec![nearest]
+        } else {
+            values
+        };
+        let count = out.len() - first;
+        for k in 0..count {
+            for (n, v) in values.iter().enumerate() {
+                if n == 0 {
+                    out[first + k][i] = *v;
+                } else {
+                    let mut shifted = out[first + k];
+                    shifted[i] = *v;
+                    out.push(shifted);
+                }
+            }
+        }
     }
-    q
 }
 
 fn limit_excess(robot: &Robot, q: &JointVector) -> (usize, Real) {
@@ -440,10 +553,26 @@ fn projected_step(
     Some(step)
 }
 
-/// Starting points for Newton on an arm whose wrist centre moves with
-/// joints 5-6 (the human arm): freeze those joints, solve the rest in
-/// closed form, re-freeze at the answer, a few times over, from every
-/// branch. Empty when the shoulder is not spherical.
+/// The arm with its shoulder axes moved through S, and, when its wrist is
+/// nearly spherical, axes 5 and 6 through W: the nearest arm with the
+/// closed-form IK, whose branches start Newton on the real one.
+fn spherical_approximation(s: &ArmStructure) -> ArmStructure {
+    let mut ideal = s.clone();
+    for p in &mut ideal.axis_points_zero[..3] {
+        *p = Vector3::zeros();
+    }
+    if s.wrist_residual > 0.0 && s.wrist_residual < 0.35 * s.forearm_length {
+        for p in &mut ideal.axis_points_zero[4..] {
+            *p = s.wrist_zero;
+        }
+    }
+    ideal
+}
+
+/// Starting points for Newton, from the spherical approximation: on an arm
+/// whose wrist centre moves with joints 5-6 (the human arm), freeze those
+/// joints, solve the rest in closed form, re-freeze at the answer, a few
+/// times over, from every branch.
 fn decoupled_guesses(
     robot: &Robot,
     elbow: &Vector3,
@@ -451,15 +580,14 @@ fn decoupled_guesses(
     ow: &Rotation3,
     near: &JointVector,
 ) -> Vec<JointVector> {
-    let s = &robot.structure;
-    if !s.shoulder_spherical {
-        return Vec::new();
-    }
+    let ideal = spherical_approximation(&robot.structure);
+    let s = &ideal;
     let (w, p) = (&s.axes_zero, &s.axis_points_zero);
     let about =
         |i: usize, angle: Real, x: &Vector3| p[i] + rotation_about(&w[i], angle) * (x - p[i]);
     let wrist_zero = |q: &JointVector| about(4, q[4], &about(5, q[5], &s.wrist_zero));
-    let solve = |q: &JointVector| branches_with_wrist(robot, &wrist_zero(q), elbow, wrist, ow, q);
+    let solve =
+        |q: &JointVector| branches_with_wrist(robot, s, &wrist_zero(q), elbow, wrist, ow, q);
     let Ok(branches) = solve(near) else { return Vec::new() };
     let mut guesses: Vec<JointVector> = branches
         .into_iter()
@@ -483,9 +611,74 @@ fn decoupled_guesses(
     guesses
 }
 
+/// What one IK call may still spend.
+struct Budget {
+    iterations: usize,
+    deadline: Option<std::time::Instant>,
+    starts: usize,
+}
+
+impl Budget {
+    fn new(options: &IkOptions) -> Self {
+        Self { iterations: options.max_total_iterations, deadline: options.deadline, starts: 0 }
+    }
+
+    /// Takes one iteration; false when none is left or the deadline passed.
+    fn take(&mut self) -> bool {
+        if self.iterations == 0 || self.deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+            self.iterations = 0;
+            return false;
+        }
+        self.iterations -= 1;
+        true
+    }
+}
+
+/// Levenberg-Marquardt from `start`, kept inside the joint limits: where it
+/// ends and its residual norm.
+fn descend<F>(
+    robot: &Robot,
+    mut q: JointVector,
+    residual: &F,
+    options: &IkOptions,
+    budget: &mut Budget,
+) -> (JointVector, Real)
+where
+    F: Fn(&JointVector) -> Result<(Vector7, Matrix7), KinematicsError>,
+{
+    budget.starts += 1;
+    clamp_to_limits(robot, &mut q);
+    let Ok((mut e, mut j)) = residual(&q) else { return (q, Real::INFINITY) };
+    let mut lambda = 1e-6;
+    for _ in 0..options.max_iterations {
+        if e.norm() < options.tolerance || !budget.take() {
+            break;
+        }
+        let Some(step) = projected_step(robot, &q, &j, &e, lambda) else {
+            lambda *= 10.0;
+            continue;
+        };
+        let mut trial = q + step;
+        clamp_to_limits(robot, &mut trial);
+        match residual(&trial) {
+            Ok((e2, j2)) if e2.norm() < e.norm() => {
+                (q, e, j) = (trial, e2, j2);
+                lambda = (lambda * 0.1).max(1e-12);
+            }
+            _ => {
+                lambda *= 10.0;
+                if lambda > 1e6 {
+                    break;
+                }
+            }
+        }
+    }
+    (q, e.norm())
+}
+
 /// Levenberg-Marquardt on a square task Jacobian, kept inside the joint
 /// limits, from `near` and the closed-form guesses (in the order the caller
-/// prefers), then Halton starts.
+/// prefers), then Halton starts, until one converges or the budget is spent.
 fn newton<F, G>(
     robot: &Robot,
     near: &JointVector,
@@ -502,6 +695,7 @@ where
         return Err(KinematicsError::NonFinite { what: "q_near" });
     }
     let mut best = Real::INFINITY;
+    let mut budget = Budget::new(options);
     // A caller's q_near is usually close: try it before paying for guesses.
     let near_start = std::iter::once(*near);
     let (before, after) =
@@ -513,37 +707,15 @@ where
         .chain(after.into_iter().flatten())
         .chain((1..).map(|k| halton_start(robot, k)))
         .take(options.max_starts);
-    for mut q in starts {
-        clamp_to_limits(robot, &mut q);
-        let Ok((mut e, mut j)) = residual(&q) else { continue };
-        let mut lambda = 1e-6;
-        for _ in 0..options.max_iterations {
-            if e.norm() < options.tolerance {
-                break;
-            }
-            let Some(step) = projected_step(robot, &q, &j, &e, lambda) else {
-                lambda *= 10.0;
-                continue;
-            };
-            let mut trial = q + step;
-            clamp_to_limits(robot, &mut trial);
-            match residual(&trial) {
-                Ok((e2, j2)) if e2.norm() < e.norm() => {
-                    (q, e, j) = (trial, e2, j2);
-                    lambda = (lambda * 0.1).max(1e-12);
-                }
-                _ => {
-                    lambda *= 10.0;
-                    if lambda > 1e6 {
-                        break;
-                    }
-                }
-            }
+    for start in starts {
+        if budget.iterations == 0 {
+            break;
         }
-        best = best.min(e.norm());
-        if e.norm() < options.tolerance.max(1e-10) {
+        let (q, e) = descend(robot, start, &residual, options, &mut budget);
+        best = best.min(e);
+        if e < converged(options) {
             return Ok(vec![q]);
         }
     }
-    Err(KinematicsError::NoConvergence { residual: best, starts: options.max_starts })
+    Err(KinematicsError::NoConvergence { residual: best, starts: budget.starts })
 }

@@ -132,11 +132,22 @@ impl PartialEq for Comment {
     }
 }
 
+/// The `robot` line: the URDF and, optionally, the chain's base and tip links.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct RobotLine {
+    /// The URDF path as written.
+    pub path: Name,
+    /// `base "link"`.
+    pub base: Option<Name>,
+    /// `tip "link"`.
+    pub tip: Option<Name>,
+}
+
 /// A top-level item.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub enum Item {
-    /// `robot "path.urdf"`.
-    Robot(Name),
+    /// `robot "path.urdf" base "link" tip "link"`.
+    Robot(RobotLine),
     /// `start ...`.
     Start(Start),
     /// `scene { ... }`.

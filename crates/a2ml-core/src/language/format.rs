@@ -143,13 +143,17 @@ impl<'a> Printer<'a> {
                 self.blank();
             }
             match item {
-                Item::Robot(path) => {
-                    // The span is the string's text; its closing quote follows.
-                    let quoted = Span { start: path.span.start, end: path.span.end + 1 };
-                    self.line(
-                        Anchor::statement(quoted, quoted),
-                        &format!("robot {}", string(path)),
-                    );
+                Item::Robot(line) => {
+                    // The span is the last string's text; its closing quote follows.
+                    let last = line.tip.as_ref().or(line.base.as_ref()).unwrap_or(&line.path);
+                    let quoted = Span { start: line.path.span.start, end: last.span.end + 1 };
+                    let mut text = format!("robot {}", string(&line.path));
+                    for (word, link) in [("base", &line.base), ("tip", &line.tip)] {
+                        if let Some(link) = link {
+                            text += &format!(" {word} {}", string(link));
+                        }
+                    }
+                    self.line(Anchor::statement(quoted, quoted), &text);
                 }
                 Item::Start(start) => {
                     let span = match start {
@@ -1171,7 +1175,7 @@ task t {
         let comments: Vec<(&str, bool)> =
             tree.comments.iter().map(|c| (c.text.as_str(), c.own_line)).collect();
         assert_eq!(comments, [("#a // b", false), ("//c # d", true)]);
-        let Item::Robot(path) = &tree.items[0] else { panic!("robot") };
+        let Item::Robot(super::super::ast::RobotLine { path, .. }) = &tree.items[0] else { panic!("robot") };
         assert_eq!(path.text, "a#b//c.urdf");
         assert_eq!(
             canonical(text),

@@ -101,6 +101,8 @@ fn describe(rule: &Rule) -> String {
     match rule {
         EOI => "end of file",
         robot => "`robot`",
+        robot_base => "`base \"link\"`",
+        robot_tip => "`tip \"link\"`",
         start => "`start`",
         scene => "`scene`",
         settings => "`settings`",
@@ -289,7 +291,19 @@ fn first_inner(node: Node<'_>) -> Node<'_> {
 
 fn item(node: Node<'_>) -> ast::Item {
     match node.as_rule() {
-        Rule::robot => ast::Item::Robot(string(first_inner(node))),
+        Rule::robot => {
+            let mut inner = node.into_inner();
+            let path = inner.next().map(string).expect("grammar guarantees a path");
+            let (mut base, mut tip) = (None, None);
+            for part in inner {
+                let link = Some(string(first_inner(part.clone())));
+                match part.as_rule() {
+                    Rule::robot_base => base = link,
+                    _ => tip = link,
+                }
+            }
+            ast::Item::Robot(ast::RobotLine { path, base, tip })
+        }
         Rule::start => ast::Item::Start(start(first_inner(node))),
         Rule::scene => {
             let sp = span(&node);

@@ -418,6 +418,10 @@ pub struct Task {
     pub name: String,
     /// The robot URDF, resolved relative to the task file.
     pub robot: PathBuf,
+    /// The chain's base link, when the `robot` line names one.
+    pub robot_base: Option<String>,
+    /// The chain's tip link, when the `robot` line names one.
+    pub robot_tip: Option<String>,
     /// The start, if given.
     pub start: Option<Start>,
     /// Obstacles.

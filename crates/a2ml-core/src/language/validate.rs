@@ -1102,18 +1102,25 @@ impl Checker<'_> {
 pub(super) fn validate(file: &ast::File, base_dir: Option<&Path>) -> Result<Task, Vec<Diagnostic>> {
     let mut c = Checker { errors: Vec::new(), base_dir, obstacles: Vec::new() };
     let mut robot: Option<PathBuf> = None;
+    let mut robot_chain: (Option<Name>, Option<Name>) = (None, None);
     let (mut seen_robot, mut start, mut scene, mut settings) = (false, None, Vec::new(), None);
     let mut tasks: Vec<&ast::Task> = Vec::new();
     let mut seen_start = false;
     let mut seen_scene = false;
     for item in &file.items {
         match item {
-            ast::Item::Robot(name) => {
+            ast::Item::Robot(line) => {
                 if seen_robot {
-                    c.error(name.span, "a file names one `robot`");
+                    c.error(line.path.span, "a file names one `robot`");
                 }
                 seen_robot = true;
-                robot = c.robot(name).or(robot);
+                robot = c.robot(&line.path).or(robot);
+                for link in [&line.base, &line.tip].into_iter().flatten() {
+                    if link.text.trim().is_empty() {
+                        c.error(link.span, "a link name cannot be empty");
+                    }
+                }
+                robot_chain = (line.base.clone(), line.tip.clone());
             }
             ast::Item::Start(s) => {
                 if seen_start {
@@ -1179,6 +1186,8 @@ pub(super) fn validate(file: &ast::File, base_dir: Option<&Path>) -> Result<Task
     Ok(Task {
         name: task.name.text.clone(),
         robot: robot.unwrap_or_default(),
+        robot_base: robot_chain.0.map(|n| n.text),
+        robot_tip: robot_chain.1.map(|n| n.text),
         start,
         scene,
         settings: settings.unwrap_or_default(),

@@ -1,46 +1,26 @@
-//! From a parsed URDF tree to the 7-joint chain. urdf-rs enters the library
-//! here and nowhere else.
+//! From a parsed URDF tree to the 7-joint chain: which chain, its joints and
+//! limits, its links, and their capsules.
 
 use std::collections::HashMap;
 
-use super::{
-    Capsule, ChainLink, Joint, JointLimits, LinkRole, Robot, RobotError, RobotOptions, structure,
-};
-use crate::math::{DOF, Isometry, Real, Rotation3, Translation3, Vector3};
+use super::urdf::{Document, JointKind};
+use super::{ChainLink, Joint, JointLimits, Robot, RobotError, RobotOptions, capsules, structure};
+use crate::math::{DOF, Isometry, PI, Real, Rotation3, Vector3};
 
-fn pose(p: &urdf_rs::Pose) -> Isometry {
-    let [x, y, z] = p.xyz.0;
-    let [roll, pitch, yaw] = p.rpy.0;
-    Isometry::from_parts(Translation3::new(x, y, z), Rotation3::from_euler_angles(roll, pitch, yaw))
-}
-
-fn is_movable(kind: &urdf_rs::JointType) -> bool {
-    !matches!(kind, urdf_rs::JointType::Fixed)
-}
-
-fn kind_name(kind: &urdf_rs::JointType) -> &'static str {
-    use urdf_rs::JointType::*;
-    match kind {
-        Revolute => "revolute",
-        Continuous => "continuous",
-        Prismatic => "prismatic",
-        Fixed => "fixed",
-        Floating => "floating",
-        Planar => "planar",
-        Spherical => "spherical",
-    }
+fn is_movable(kind: JointKind) -> bool {
+    kind != JointKind::Fixed
 }
 
 struct Tree<'a> {
-    urdf: &'a urdf_rs::Robot,
+    urdf: &'a Document,
     /// child link -> index of the joint whose child it is
     parent_joint: HashMap<&'a str, usize>,
 }
 
 impl<'a> Tree<'a> {
-    fn new(urdf: &'a urdf_rs::Robot) -> Self {
+    fn new(urdf: &'a Document) -> Self {
         let parent_joint =
-            urdf.joints.iter().enumerate().map(|(i, j)| (j.child.link.as_str(), i)).collect();
+            urdf.joints.iter().enumerate().map(|(i, j)| (j.child.as_str(), i)).collect();
         Self { urdf, parent_joint }
     }
 
@@ -66,7 +46,7 @@ impl<'a> Tree<'a> {
         while link != base {
             let j = *self.parent_joint.get(link)?;
             joints.push(j);
-            link = &self.urdf.joints[j].parent.link;
+            link = &self.urdf.joints[j].parent;
         }
         joints.reverse();
         Some(joints)
@@ -92,7 +72,7 @@ impl<'a> Tree<'a> {
 
     fn leaves_below(&self, base: &str) -> Vec<&'a str> {
         let parents: std::collections::HashSet<&str> =
-            self.urdf.joints.iter().map(|j| j.parent.link.as_str()).collect();
+            self.urdf.joints.iter().map(|j| j.parent.as_str()).collect();
         self.urdf
             .links
             .iter()
@@ -102,11 +82,15 @@ impl<'a> Tree<'a> {
     }
 
     fn movable(&self, path: &[usize]) -> Vec<usize> {
-        path.iter().copied().filter(|&j| is_movable(&self.urdf.joints[j].joint_type)).collect()
+        path.iter().copied().filter(|&j| is_movable(self.urdf.joints[j].kind)).collect()
     }
 
     /// The base link and the joint path of the chain the options select.
-    fn select(&self, options: &RobotOptions) -> Result<(String, Vec<usize>), RobotError> {
+    fn select(
+        &self,
+        options: &RobotOptions,
+        is_arm: &dyn Fn(&str, &str) -> bool,
+    ) -> Result<(String, Vec<usize>), RobotError> {
         let base = match &options.base {
             Some(b) => {
                 self.check_link(b)?;
@@ -128,7 +112,7 @@ impl<'a> Tree<'a> {
         let Some(first) = seven.first() else {
             let longest = paths.iter().map(|p| self.movable(p).len()).max().unwrap_or(0);
             return Err(if longest > DOF || longest == 0 {
-                RobotError::NoSevenDofChain { longest }
+                RobotError::NoSevenDofChain { longest, candidates: self.candidates(&paths, is_arm) }
             } else {
                 let p =
                     paths.iter().max_by_key(|p| self.movable(p).len()).cloned().unwrap_or_default();
@@ -137,11 +121,7 @@ impl<'a> Tree<'a> {
         };
         let joints = self.movable(first);
         if seven.iter().any(|p| self.movable(p) != joints) {
-            let tips: Vec<String> = seven
-                .iter()
-                .filter_map(|p| p.last().map(|&j| self.urdf.joints[j].child.link.clone()))
-                .collect();
-            return Err(RobotError::AmbiguousChain { tips: tips.join(", ") });
+            return Err(RobotError::AmbiguousChain { candidates: self.candidates(&paths, is_arm) });
         }
         // Several leaves past the 7th joint: stop where their paths part.
         let common = (0..)
@@ -150,9 +130,46 @@ impl<'a> Tree<'a> {
         Ok((base, first[..common].to_vec()))
     }
 
+    /// Every run of 7 consecutive rotating joints on the given paths, as
+    /// `base -> tip` link pairs: the choices a user can pass as base and tip;
+    /// only those that are shoulder-elbow-wrist arms when there are any.
+    fn candidates(&self, paths: &[Vec<usize>], is_arm: &dyn Fn(&str, &str) -> bool) -> String {
+        let mut pairs: Vec<(String, String)> = Vec::new();
+        for path in paths {
+            let movable = self.movable(path);
+            for window in movable.windows(DOF) {
+                let rotating = window.iter().all(|&j| {
+                    matches!(self.urdf.joints[j].kind, JointKind::Revolute | JointKind::Continuous)
+                });
+                let pair = (
+                    self.urdf.joints[window[0]].parent.clone(),
+                    self.urdf.joints[window[DOF - 1]].child.clone(),
+                );
+                if rotating && !pairs.contains(&pair) {
+                    pairs.push(pair);
+                }
+            }
+        }
+        if pairs.is_empty() {
+            return "none: no run of 7 revolute joints".into();
+        }
+        let arms: Vec<(String, String)> =
+            pairs.iter().filter(|(b, t)| is_arm(b, t)).cloned().collect();
+        if !arms.is_empty() {
+            pairs = arms;
+        }
+        const SHOWN: usize = 12;
+        let mut text: Vec<String> =
+            pairs.iter().take(SHOWN).map(|(b, t)| format!("base `{b}` tip `{t}`")).collect();
+        if pairs.len() > SHOWN {
+            text.push(format!("and {} more", pairs.len() - SHOWN));
+        }
+        text.join("; ")
+    }
+
     fn not_seven(&self, base: &str, path: &[usize]) -> RobotError {
         let movable = self.movable(path);
-        let tip = path.last().map_or(base.to_owned(), |&j| self.urdf.joints[j].child.link.clone());
+        let tip = path.last().map_or(base.to_owned(), |&j| self.urdf.joints[j].child.clone());
         RobotError::NotSevenDof {
             base: base.to_owned(),
             tip,
@@ -166,14 +183,17 @@ impl<'a> Tree<'a> {
     }
 }
 
-fn limits(joint: &urdf_rs::Joint) -> Result<JointLimits, RobotError> {
-    let l = &joint.limit;
-    let ok = l.lower.is_finite()
-        && l.upper.is_finite()
-        && l.lower < l.upper
-        && l.velocity.is_finite()
-        && l.velocity > 0.0;
-    if !ok {
+/// Planning window of a continuous joint: two turns either way of zero, so
+/// that every angle has a 2π shift inside it with room to move past ±π.
+pub(crate) const CONTINUOUS_RANGE: Real = 2.0 * PI;
+
+fn limits(joint: &super::urdf::Joint) -> Result<JointLimits, RobotError> {
+    let l = joint.limit.unwrap_or(super::urdf::Limit { lower: 0.0, upper: 0.0, velocity: 0.0 });
+    let (lower, upper) = match joint.kind {
+        JointKind::Continuous => (-CONTINUOUS_RANGE, CONTINUOUS_RANGE),
+        _ => (l.lower, l.upper),
+    };
+    if !(lower < upper && l.velocity > 0.0) {
         return Err(RobotError::JointWithoutLimits {
             joint: joint.name.clone(),
             lower: l.lower,
@@ -181,46 +201,18 @@ fn limits(joint: &urdf_rs::Joint) -> Result<JointLimits, RobotError> {
             velocity: l.velocity,
         });
     }
-    Ok(JointLimits { lower: l.lower, upper: l.upper, velocity: l.velocity })
+    Ok(JointLimits { lower, upper, velocity: l.velocity })
 }
 
-fn unit_axis(joint: &urdf_rs::Joint) -> Result<Vector3, RobotError> {
-    let [x, y, z] = joint.axis.xyz.0;
-    let v = Vector3::new(x, y, z);
-    let n = v.norm();
+fn unit_axis(joint: &super::urdf::Joint) -> Result<Vector3, RobotError> {
+    let n = joint.axis.norm();
     if !(n.is_finite() && n > 1e-12) {
         return Err(RobotError::Urdf {
             path: None,
-            message: format!("joint `{}` has a zero axis", joint.name),
+            message: format!("line {}, <joint name=\"{}\">: a zero axis", joint.line, joint.name),
         });
     }
-    Ok(v / n)
-}
-
-fn capsules_of(link: &urdf_rs::Link, chain_link: &ChainLink) -> Vec<Capsule> {
-    link.collision
-        .iter()
-        .filter_map(|c| {
-            let (radius, length) = match c.geometry {
-                urdf_rs::Geometry::Cylinder { radius, length }
-                | urdf_rs::Geometry::Capsule { radius, length } => (radius, length),
-                urdf_rs::Geometry::Sphere { radius } => (radius, 0.0),
-                // Boxes and meshes have no capsule reading; they are ignored.
-                _ => return None,
-            };
-            let frame_from_shape = chain_link.frame_from_link * pose(&c.origin);
-            let half = Vector3::new(0.0, 0.0, 0.5 * length);
-            Some(Capsule {
-                name: c.name.clone().unwrap_or_else(|| link.name.clone()),
-                link: link.name.clone(),
-                role: LinkRole::of_frame(chain_link.frame),
-                frame: chain_link.frame,
-                a: frame_from_shape.transform_point(&(-half).into()).coords,
-                b: frame_from_shape.transform_point(&half.into()).coords,
-                radius,
-            })
-        })
-        .collect()
+    Ok(joint.axis / n)
 }
 
 fn hand_rotation(options: &RobotOptions) -> Result<Rotation3, RobotError> {
@@ -236,13 +228,27 @@ fn hand_rotation(options: &RobotOptions) -> Result<Rotation3, RobotError> {
     }
 }
 
+/// The 7-joint chain the options select, with its capsules.
 pub(super) fn build(
-    urdf: &urdf_rs::Robot,
+    urdf: &Document,
     text: &str,
     options: &RobotOptions,
 ) -> Result<Robot, RobotError> {
     let tree = Tree::new(urdf);
-    let (base, path) = tree.select(options)?;
+    let is_arm = |base: &str, tip: &str| {
+        let quick = RobotOptions {
+            base: Some(base.to_owned()),
+            tip: Some(tip.to_owned()),
+            geometry: super::GeometryOptions {
+                package_path: Vec::new(),
+                urdf_dir: None,
+                skeleton_radius: None,
+            },
+            ..options.clone()
+        };
+        build(urdf, "", &quick).is_ok()
+    };
+    let (base, path) = tree.select(options, &is_arm)?;
     let movable = tree.movable(&path);
     if movable.len() != DOF {
         return Err(tree.not_seven(&base, &path));
@@ -259,40 +265,36 @@ pub(super) fn build(
     let mut acc = Isometry::identity();
     for &j in &path {
         let joint = &urdf.joints[j];
-        match joint.joint_type {
-            urdf_rs::JointType::Fixed => acc *= pose(&joint.origin),
-            urdf_rs::JointType::Revolute => {
+        if let (Some(mimic), true) = (&joint.mimic, is_movable(joint.kind)) {
+            return Err(RobotError::MimicJoint {
+                joint: joint.name.clone(),
+                follows: mimic.joint.clone(),
+            });
+        }
+        match joint.kind {
+            JointKind::Fixed => acc *= joint.parent_from_joint,
+            JointKind::Revolute | JointKind::Continuous => {
                 joints.push(Joint {
                     name: joint.name.clone(),
-                    parent_from_joint: acc * pose(&joint.origin),
+                    parent_from_joint: acc * joint.parent_from_joint,
                     axis: unit_axis(joint)?,
                     limits: limits(joint)?,
+                    continuous: joint.kind == JointKind::Continuous,
                 });
                 acc = Isometry::identity();
             }
-            urdf_rs::JointType::Continuous => {
-                return Err(RobotError::JointWithoutLimits {
-                    joint: joint.name.clone(),
-                    lower: Real::NEG_INFINITY,
-                    upper: Real::INFINITY,
-                    velocity: joint.limit.velocity,
-                });
-            }
-            ref other => {
+            other => {
                 return Err(RobotError::UnsupportedJoint {
                     joint: joint.name.clone(),
-                    kind: kind_name(other).to_owned(),
+                    kind: other.as_str().to_owned(),
                 });
             }
         }
-        links.push(ChainLink {
-            name: joint.child.link.clone(),
-            frame: joints.len(),
-            frame_from_link: acc,
-        });
+        links.push(ChainLink { name: joint.child.clone(), frame: joints.len(), frame_from_link: acc });
     }
     let tip = links.last().map(|l| l.name.clone()).unwrap_or_else(|| base.clone());
     let frame7_from_hand = acc.rotation * tool;
+    let tip_in_frame7 = acc.translation.vector;
 
     let mut frames_zero = [Isometry::identity(); DOF + 1];
     let mut axes = [Vector3::zeros(); DOF];
@@ -316,11 +318,9 @@ pub(super) fn build(
     for link in links.iter_mut().filter(|l| l.frame == 0) {
         link.frame_from_link = b_from_base_link * link.frame_from_link;
     }
-    let capsules = links
-        .iter()
-        .filter_map(|cl| urdf.links.iter().find(|l| l.name == cl.name).map(|l| capsules_of(l, cl)))
-        .flatten()
-        .collect();
+    let skeleton = capsules::Skeleton::new(&structure, &frames_zero, tip_in_frame7);
+    let (capsules, geometry_warnings) =
+        capsules::build(urdf, &links, &skeleton, &options.geometry)?;
 
     let joints: [Joint; DOF] = joints.try_into().map_err(|_| tree.not_seven(&base, &path))?;
     Ok(Robot {
@@ -334,6 +334,7 @@ pub(super) fn build(
         frame7_from_hand,
         vertical,
         structure,
+        geometry_warnings,
         urdf: text.to_owned(),
     })
 }

@@ -55,17 +55,38 @@ pub enum RobotError {
         /// Their names, comma separated.
         joints: String,
     },
-    /// No chain of the tree has 7 revolute joints.
-    #[error("no chain of 7 revolute joints in the URDF (longest has {longest})")]
+    /// No chain of the tree has exactly 7 moving joints.
+    #[error(
+        "no chain of exactly 7 moving joints in the URDF (longest has {longest}); choose one with \
+         base and tip links (`--base`/`--tip`, or `robot \"...\" base \"...\" tip \"...\"`); \
+         candidates: {candidates}"
+    )]
     NoSevenDofChain {
-        /// Revolute joints on the longest chain.
+        /// Moving joints on the longest chain.
         longest: usize,
+        /// Runs of 7 revolute joints as base/tip pairs, `; ` separated.
+        candidates: String,
     },
     /// Several different 7-joint chains: base and tip must be given.
-    #[error("several 7-joint chains (tips: {tips}); choose one with a tip link")]
+    #[error(
+        "several 7-joint chains; choose one with base and tip links (`--base`/`--tip`, or \
+         `robot \"...\" base \"...\" tip \"...\"`); candidates: {candidates}"
+    )]
     AmbiguousChain {
-        /// Candidate tip links, comma separated.
-        tips: String,
+        /// Candidate base/tip pairs, `; ` separated.
+        candidates: String,
+    },
+    /// A joint of the chain copies another joint's motion.
+    #[error(
+        "joint `{joint}` mimics `{follows}`: a2ml plans 7 independent joints, so a mimic joint \
+         inside the chain is refused (mimic joints outside it, such as gripper fingers, are \
+         ignored); choose a tip before it"
+    )]
+    MimicJoint {
+        /// The mimic joint.
+        joint: String,
+        /// The joint it follows.
+        follows: String,
     },
     /// A joint type that an arm chain cannot contain.
     #[error("joint `{joint}` is {kind}; an arm chain holds revolute and fixed joints only")]
@@ -90,7 +111,10 @@ pub enum RobotError {
         velocity: Real,
     },
     /// The geometry is not that of a shoulder-elbow-wrist arm.
-    #[error("not an anthropomorphic arm: {reason}")]
+    #[error(
+        "not a shoulder-elbow-wrist arm: {reason}; if the URDF holds such an arm, choose its \
+         chain with other base and tip links"
+    )]
     NotAnthropomorphic {
         /// What is wrong.
         reason: String,

@@ -6,10 +6,13 @@
 //! Every position of the model is in the base frame {b}: the axes of the
 //! chain's base link, the origin at the shoulder centre S (DESIGN.md §2).
 
+mod capsules;
 mod chain;
 mod error;
 mod structure;
+mod urdf;
 
+pub use capsules::{CapsuleSource, DEFAULT_SKELETON_RADIUS, GeometryOptions};
 pub use error::RobotError;
 pub use structure::{ArmStructure, least_squares_point, line_distance};
 
@@ -48,8 +51,11 @@ pub struct Joint {
     pub parent_from_joint: Isometry,
     /// Unit rotation axis in the joint frame.
     pub axis: Vector3,
-    /// Position and velocity limits.
+    /// Position and velocity limits; a continuous joint plans within
+    /// ±2π, where every angle has a 2π shift.
     pub limits: JointLimits,
+    /// A URDF `continuous` joint: no mechanical limit.
+    pub continuous: bool,
 }
 
 /// A link of the chain, rigidly attached to one moving frame.
@@ -116,6 +122,8 @@ pub struct Capsule {
     pub b: Vector3,
     /// Radius (m).
     pub radius: Real,
+    /// Where the capsule came from.
+    pub source: CapsuleSource,
 }
 
 impl Capsule {
@@ -138,6 +146,8 @@ pub struct RobotOptions {
     pub palm_axis: Vector3,
     /// The vertical direction z_b, in the base link.
     pub vertical: Vector3,
+    /// Where capsules come from when the URDF has no capsule shapes.
+    pub geometry: GeometryOptions,
 }
 
 impl Default for RobotOptions {
@@ -148,6 +158,7 @@ impl Default for RobotOptions {
             finger_axis: Vector3::z(),
             palm_axis: Vector3::x(),
             vertical: Vector3::z(),
+            geometry: GeometryOptions::default(),
         }
     }
 }
@@ -175,6 +186,9 @@ pub struct Robot {
     pub vertical: Vector3,
     /// Shoulder, elbow and wrist structure.
     pub structure: ArmStructure,
+    /// Capsules that are not the URDF's own shapes (boxes, meshes, the
+    /// skeleton) and parts of the arm left without any, one message each.
+    pub geometry_warnings: Vec<String>,
     /// The URDF document the model was read from (to attach to outputs and
     /// to rebuild the model elsewhere).
     pub urdf: String,
@@ -206,7 +220,11 @@ impl Robot {
                 RobotError::Io { path: path.display().to_string(), message: source.to_string() }
             }
         })?;
-        Self::from_urdf_str(&text, options).map_err(|e| e.in_file(path))
+        let mut options = options.clone();
+        if options.geometry.urdf_dir.is_none() {
+            options.geometry.urdf_dir = path.parent().map(std::path::Path::to_path_buf);
+        }
+        Self::from_urdf_str(&text, &options).map_err(|e| e.in_file(path))
     }
 
     /// Reads a URDF document.
@@ -214,9 +232,7 @@ impl Robot {
     /// # Errors
     /// As [`Robot::from_urdf_file`].
     pub fn from_urdf_str(text: &str, options: &RobotOptions) -> Result<Self, RobotError> {
-        let urdf = urdf_rs::read_from_string(text)
-            .map_err(|e| RobotError::Urdf { path: None, message: e.to_string() })?;
-        chain::build(&urdf, text, options)
+        chain::build(&urdf::parse(text)?, text, options)
     }
 
     /// Joint names, base to tip.
@@ -265,6 +281,14 @@ impl Robot {
     /// Forearm length lf = |W - E| at zero configuration (m).
     pub fn forearm_length(&self) -> Real {
         self.structure.forearm_length
+    }
+
+    /// Whether every part of the arm (upper arm, forearm, hand) carries a
+    /// capsule, so that obstacles can be checked against the whole arm.
+    pub fn has_arm_geometry(&self) -> bool {
+        [LinkRole::UpperArm, LinkRole::Forearm, LinkRole::Hand]
+            .iter()
+            .all(|role| self.capsules.iter().any(|c| c.role == *role))
     }
 
     /// Whether IK is analytic: a spherical shoulder, and a wrist centre that

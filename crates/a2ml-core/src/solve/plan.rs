@@ -49,6 +49,16 @@ pub enum SolveError {
     /// The decomposition failed.
     #[error(transparent)]
     Decompose(#[from] DecomposeError),
+    /// The task has obstacles but parts of the arm carry no capsule.
+    #[error(
+        "the task has obstacles but the robot has no collision geometry on some of its parts, \
+         so they cannot be checked: {}",
+        warnings.join("; ")
+    )]
+    NoArmGeometry {
+        /// The robot's geometry warnings.
+        warnings: Vec<String>,
+    },
     /// The output rate is not positive and finite.
     #[error("invalid output rate {rate} Hz: it must be positive and finite")]
     InvalidRate {
@@ -130,6 +140,9 @@ pub fn plan_with_progress(
     if !(rate.is_finite() && rate > 0.0) {
         return Err(SolveError::InvalidRate { rate });
     }
+    if !task.scene.is_empty() && !robot.has_arm_geometry() {
+        return Err(SolveError::NoArmGeometry { warnings: robot.geometry_warnings.clone() });
+    }
     let decomposition = decompose(robot, task, &options.decompose)?;
     let task_b = task.in_base_frame(&robot.structure.shoulder_in_base_link);
     let total = decomposition.actions.iter().map(|a| a.segments.len()).sum();
@@ -155,6 +168,9 @@ pub fn plan_with_progress(
         None => Trajectory::new(vec![0.0], vec![decomposition.start], vec![JointVector::zeros()])?,
     };
     let mut warnings = state.notes;
+    if !task.scene.is_empty() {
+        warnings.extend(robot.geometry_warnings.iter().map(|w| format!("collision geometry: {w}")));
+    }
     warnings.extend(state.segments.iter().filter(|s| !s.reached).map(missed));
     warnings.extend(state.segments.iter().filter(|s| !s.path_kept).map(left_path));
     Ok(Plan {
