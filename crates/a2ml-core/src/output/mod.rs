@@ -11,12 +11,17 @@ mod csv;
 mod json;
 mod mcap_file;
 mod messages;
+mod read;
 mod schemas;
 
 #[cfg(test)]
 mod tests;
 
 use std::path::Path;
+
+pub use read::{
+    ReadError, RecordedPlan, RecordedSegment, read_csv, read_csv_str, read_mcap, read_mcap_bytes,
+};
 
 use crate::language::Task;
 use crate::math::Real;
