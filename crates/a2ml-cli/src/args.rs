@@ -3,6 +3,7 @@
 
 use clap::{Parser, Subcommand};
 
+use crate::commands::analyze::AnalyzeArgs;
 use crate::commands::check::CheckArgs;
 use crate::commands::explain::ExplainArgs;
 use crate::commands::fmt::FmtArgs;
@@ -21,6 +22,7 @@ Examples:
   a2ml fmt --write task.a2ml
   a2ml explain examples/type_iv_forward_bar.a2ml
   a2ml plan examples/construct_path_line.a2ml -o lines.mcap
+  a2ml analyze lines.mcap
 
 Exit codes: 0 success, 1 I/O error, 2 invalid input, 3 a goal missed (plan
 written), 4 planning failed.")]
@@ -43,6 +45,8 @@ pub enum Commands {
     Explain(ExplainArgs),
     /// Plan a task's motion and write it as MCAP (for Foxglove), CSV or JSON.
     Plan(PlanArgs),
+    /// Measure how human-like a written plan is: RULA, motion patterns, Fitts, bell shape.
+    Analyze(AnalyzeArgs),
 }
 
 /// How `robot`, `explain` and `plan` read the arm from its URDF.

@@ -27,4 +27,7 @@ pub enum Error {
     /// An output file cannot be written.
     #[error(transparent)]
     Output(#[from] crate::output::OutputError),
+    /// A plan file cannot be read back.
+    #[error(transparent)]
+    Read(#[from] crate::output::ReadError),
 }

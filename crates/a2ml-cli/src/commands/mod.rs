@@ -2,6 +2,7 @@
 //! that calls the core and prints the result. [`run`] dispatches;
 //! [`load_task`] is how the commands that take one task file read it.
 
+pub mod analyze;
 pub mod check;
 pub mod explain;
 pub mod fmt;
@@ -28,6 +29,7 @@ pub fn run(cli: Cli, temporaries: &Temporaries) -> Result<(), CliError> {
         Commands::Fmt(args) => fmt::run(&args),
         Commands::Explain(args) => explain::run(&args),
         Commands::Plan(args) => plan::run(&args, temporaries),
+        Commands::Analyze(args) => analyze::run(&args),
     }
 }
 

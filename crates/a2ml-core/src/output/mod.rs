@@ -12,6 +12,7 @@ mod csv;
 mod json;
 mod mcap_file;
 mod messages;
+mod read;
 mod schemas;
 
 #[cfg(test)]
@@ -20,6 +21,9 @@ mod tests;
 use std::path::Path;
 
 pub use atomic::{Staged, refused_kind};
+pub use read::{
+    ReadError, RecordedPlan, RecordedSegment, read_csv, read_csv_str, read_mcap, read_mcap_bytes,
+};
 
 use crate::language::Task;
 use crate::math::Real;

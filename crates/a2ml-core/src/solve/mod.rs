@@ -3,9 +3,11 @@
 //! Entry points: [`plan`] (a task to a [`Plan`]: trajectory and one [`SegmentReport`] per
 //! segment), [`qp::solve_segment`] (one segment with the velocity QP) and
 //! [`rrt::rrt_connect`] (a collision-free joint-space path) and
-//! [`constrained_rrt::constrained_rrt`] (one that keeps a segment's path constraint exactly).
+//! [`constrained_rrt::constrained_rrt`] (one that keeps a segment's path constraint exactly);
+//! [`hamp::plan_handover`] plans a handover the HAMP way (METHODS.md §3.4).
 
 pub mod constrained_rrt;
+pub mod hamp;
 mod plan;
 pub mod qp;
 mod report;

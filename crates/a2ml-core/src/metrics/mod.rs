@@ -1,0 +1,16 @@
+//! Human-likeness of a motion, measured (METHODS.md §3): RULA group A per frame ([`rula`]),
+//! the HAMP motion patterns and their similarity indices ([`pattern`]), durations against
+//! Fitts' law ([`fitts`]) and the bell shape of the wrist speed.
+//!
+//! Entry point: [`analyze`] (a robot and a trajectory, fresh or read back from a file, to
+//! per-frame and per-segment measures). Conventions and angle definitions: docs/metrics.md.
+
+pub mod fitts;
+mod motion;
+pub mod pattern;
+pub mod rula;
+
+pub use motion::{
+    Analysis, BellShape, FrameMetrics, MetricsOptions, ScoreSummary, Span, SpanMetrics, analyze,
+    bell_shape, frame_metrics, span_metrics,
+};
