@@ -17,3 +17,4 @@ mod robots;
 mod rrt;
 mod segments;
 mod swivel;
+mod map;

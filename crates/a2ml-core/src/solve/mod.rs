@@ -6,7 +6,8 @@
 //! [`constrained_rrt::constrained_rrt`] (one that keeps a segment's path constraint exactly).
 
 pub mod constrained_rrt;
-mod plan;
+pub mod map;
+pub(crate) mod plan;
 pub mod qp;
 mod report;
 pub mod rrt;
