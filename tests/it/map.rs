@@ -8,9 +8,7 @@ use a2ml::kinematics::{CpsaState, arm_pose, cpsa_state, cpsa_to_hat, ik_cpsa};
 use a2ml::language::{Obstacle, Shape};
 use a2ml::math::{JointVector, PI, Real, Rotation3, Vector3, wrap_angle};
 use a2ml::solve::map::sphere::{AxialCapsule, ElbowCircle, HalfWidth, half_width};
-use a2ml::solve::map::{
-    MapError, MapOptions, SwivelTargets, WristMotion, build_map, plan_profile,
-};
+use a2ml::solve::map::{MapError, MapOptions, SwivelTargets, WristMotion, build_map, plan_profile};
 use rand::RngExt;
 
 use crate::common::{load, random_q, regularity, rng};
@@ -29,7 +27,10 @@ fn paper_points() -> Vec<Vector3> {
 }
 
 fn paper_spheres() -> Vec<Obstacle> {
-    vec![sphere("sphere1", mm(33.0, 63.0, 0.0), 0.020), sphere("sphere2", mm(45.0, 95.0, 10.0), 0.015)]
+    vec![
+        sphere("sphere1", mm(33.0, 63.0, 0.0), 0.020),
+        sphere("sphere2", mm(45.0, 95.0, 10.0), 0.015),
+    ]
 }
 
 fn paper_motion(ow: Rotation3) -> WristMotion {
@@ -77,7 +78,11 @@ fn sphere_interval_matches_a_brute_force_sweep() {
     while scenes < 300 {
         let (lu, lf) = (r.random_range(0.2..0.45), r.random_range(0.2..0.45));
         let (rho_u, rho_f) = (r.random_range(0.0..0.05), r.random_range(0.0..0.05));
-        let dir = Vector3::new(r.random_range(-1.0..1.0), r.random_range(-1.0..1.0), r.random_range(-1.0..1.0));
+        let dir = Vector3::new(
+            r.random_range(-1.0..1.0),
+            r.random_range(-1.0..1.0),
+            r.random_range(-1.0..1.0),
+        );
         if dir.norm() < 0.1 || dir.normalize().z.abs() > 0.99 {
             continue;
         }
@@ -87,12 +92,18 @@ fn sphere_interval_matches_a_brute_force_sweep() {
         // Near the arm, so that most scenes forbid part of the circle.
         let near = circle.elbow(r.random_range(-PI..PI)) * r.random_range(0.3..1.3);
         let center = near
-            + Vector3::new(r.random_range(-0.1..0.1), r.random_range(-0.1..0.1), r.random_range(-0.1..0.1));
+            + Vector3::new(
+                r.random_range(-0.1..0.1),
+                r.random_range(-0.1..0.1),
+                r.random_range(-0.1..0.1),
+            );
         let radius = r.random_range(0.01..0.15);
         scenes += 1;
         let (h, p, phase) = circle.cylindrical(&center);
-        let upper = AxialCapsule { a: (0.0, 0.0), b: (circle.centre, circle.radius), radius: rho_u };
-        let fore = AxialCapsule { a: (circle.centre, circle.radius), b: (reach, 0.0), radius: rho_f };
+        let upper =
+            AxialCapsule { a: (0.0, 0.0), b: (circle.centre, circle.radius), radius: rho_u };
+        let fore =
+            AxialCapsule { a: (circle.centre, circle.radius), b: (reach, 0.0), radius: rho_f };
         let width = |c: &AxialCapsule| match half_width(c, (h, p), radius, 0.0) {
             HalfWidth::Empty => -1.0,
             HalfWidth::Within(w) => w,
@@ -136,7 +147,8 @@ fn paper_half_widths(t: Real, rho: Real) -> [Option<Real>; 2] {
     let pw = motion.at(t).pw;
     let circle = ElbowCircle::new(0.0727, 0.068, &pw, &Vector3::z()).expect("reach");
     let upper = AxialCapsule { a: (0.0, 0.0), b: (circle.centre, circle.radius), radius: rho };
-    let fore = AxialCapsule { a: (circle.centre, circle.radius), b: (circle.reach, 0.0), radius: rho };
+    let fore =
+        AxialCapsule { a: (circle.centre, circle.radius), b: (circle.reach, 0.0), radius: rho };
     paper_spheres().map_into(|o| {
         let Shape::Sphere { center, radius } = o.shape else { unreachable!() };
         let (h, p, _) = circle.cylindrical(&center);
@@ -224,6 +236,15 @@ fn paper_scenario_derived_numbers() {
     }
 }
 
+/// A held hand orientation whose palm normal p (the axis of joint 7) stays far from every
+/// forearm direction of the motion: p along the mean shoulder–wrist direction, 68° from the
+/// cone the forearm sweeps about it, keeps the wrist away from its singularity.
+fn paper_ow() -> Rotation3 {
+    let p = Vector3::new(0.3, 0.93, 0.12).normalize();
+    let f = (Vector3::z() - p * p.z).normalize();
+    Rotation3::from_basis_unchecked(&[f, p, f.cross(&p)])
+}
+
 fn paper_arm() -> a2ml::Robot {
     load("swivel_map_arm")
 }
@@ -246,7 +267,7 @@ fn paper_scene_with_box() -> Vec<Obstacle> {
 #[test]
 fn every_cell_matches_a_direct_check() {
     let robot = paper_arm();
-    let motion = paper_motion(Rotation3::identity());
+    let motion = paper_motion(paper_ow());
     let obstacles = paper_scene_with_box();
     let scene = CollisionScene::new(&obstacles);
     let start = start_at(&robot, &motion, 2.5);
@@ -291,7 +312,7 @@ fn every_cell_matches_a_direct_check() {
 #[test]
 fn planned_profile_holds_at_one_kilohertz() {
     let robot = paper_arm();
-    let motion = paper_motion(Rotation3::identity());
+    let motion = paper_motion(paper_ow());
     let obstacles = paper_spheres();
     let scene = CollisionScene::new(&obstacles);
     let safety = 0.001;
@@ -307,15 +328,27 @@ fn planned_profile_holds_at_one_kilohertz() {
     let first = probe.intervals.iter().find(|i| i.column == 0 && i.obstacle == 0).expect("Δ1");
     let start = start_at(&robot, &motion, wrap_angle(first.centre + PI));
     let map = build_map(&robot, &obstacles, &motion, &start, &options).expect("map");
-    let profile = plan_profile(&robot, &obstacles, &motion, &map, &start, &SwivelTargets::default(), &options)
-        .expect("profile");
+    let profile = plan_profile(
+        &robot,
+        &obstacles,
+        &motion,
+        &map,
+        &start,
+        &SwivelTargets::default(),
+        &options,
+    )
+    .expect("profile");
     let trajectory = &profile.trajectory;
     let times = trajectory.times();
-    assert!((times[1] - times[0] - 1e-3).abs() < 1e-9 && (times[times.len() - 1] - 5.0).abs() < 1e-12);
+    assert!(
+        (times[1] - times[0] - 1e-3).abs() < 1e-9 && (times[times.len() - 1] - 5.0).abs() < 1e-12
+    );
     assert!((trajectory.positions()[0] - start).amax() < 1e-9, "starts where the arm is");
     let (lower, upper, speed) = (robot.lower(), robot.upper(), robot.velocity_limits());
     let mut worst_track: Real = 0.0;
-    for (k, ((t, q), qd)) in times.iter().zip(trajectory.positions()).zip(trajectory.velocities()).enumerate() {
+    for (k, ((t, q), qd)) in
+        times.iter().zip(trajectory.positions()).zip(trajectory.velocities()).enumerate()
+    {
         let pose = arm_pose(&robot, q);
         let (d, link, obstacle) = min_distance(&robot, &pose, &scene).expect("pairs");
         assert!(d >= safety, "t = {t}: {link} – {obstacle} at {d}");
@@ -344,14 +377,22 @@ fn planned_profile_holds_at_one_kilohertz() {
 #[test]
 fn a_sphere_on_the_wrist_path_names_the_time_it_cuts() {
     let robot = paper_arm();
-    let motion = paper_motion(Rotation3::identity());
+    let motion = paper_motion(paper_ow());
     let center = motion.at(2.5).pw;
     let obstacles = vec![sphere("on_path", center, 0.004)];
     let start = start_at(&robot, &motion, 2.0);
     let options = MapOptions { time_steps: 101, ..MapOptions::default() };
     let map = build_map(&robot, &obstacles, &motion, &start, &options).expect("map");
-    let error = plan_profile(&robot, &obstacles, &motion, &map, &start, &SwivelTargets::default(), &options)
-        .expect_err("no profile through a sphere on the wrist path");
+    let error = plan_profile(
+        &robot,
+        &obstacles,
+        &motion,
+        &map,
+        &start,
+        &SwivelTargets::default(),
+        &options,
+    )
+    .expect_err("no profile through a sphere on the wrist path");
     // The forearm's wrist end enters the sphere (radius 4 + 5 mm) at this time.
     let enter = (0..=5000)
         .map(|k| k as Real * 1e-3)
@@ -359,7 +400,10 @@ fn a_sphere_on_the_wrist_path_names_the_time_it_cuts() {
         .expect("enters");
     let MapError::NoProfile { time, .. } = error else { panic!("{error}") };
     let dt = map.times[1];
-    assert!(time >= enter - 0.5 && time <= enter + dt, "cut at {time}, the wrist enters at {enter}");
+    assert!(
+        time >= enter - 0.5 && time <= enter + dt,
+        "cut at {time}, the wrist enters at {enter}"
+    );
     // The column at the cut, or the one before, is forbidden at every angle reachable.
     let column = map.times.iter().position(|&t| (t - time).abs() < 1e-12).expect("a column");
     assert!((0..map.angles.len()).any(|j| !map.is_free(column, j)));
@@ -372,7 +416,8 @@ fn map_solver_plans_the_example_task() {
     let text = std::fs::read_to_string(&path).expect("example");
     let task = a2ml::language::parse(&text, Some(std::path::Path::new(&path))).expect("task");
     let robot = a2ml::Robot::from_urdf_file(&task.robot).expect("robot");
-    let plan = a2ml::solve::plan(&robot, &task, &a2ml::solve::PlanOptions::default()).expect("plan");
+    let plan =
+        a2ml::solve::plan(&robot, &task, &a2ml::solve::PlanOptions::default()).expect("plan");
     let segment = &plan.segments[0];
     assert_eq!(segment.solver, a2ml::language::SolverChoice::Map);
     assert!(segment.reached, "{:?}", segment.errors);

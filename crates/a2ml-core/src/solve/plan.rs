@@ -415,8 +415,10 @@ impl Solver<'_> {
     /// smoothest free profile (to its goal, if it has one), joints by analytic IK.
     fn map(&mut self, job: &Job) -> Result<Solved, SolveError> {
         let obstacles = self.task.action_scene(job.action.index);
-        let options =
-            MapOptions { safety_distance: self.options.qp.safety_distance, ..self.options.map.clone() };
+        let options = MapOptions {
+            safety_distance: self.options.qp.safety_distance,
+            ..self.options.map.clone()
+        };
         let (_, profile) = map_segment(self.robot, &obstacles, &job.problem, &self.q, &options)
             .map_err(|source| SolveError::Map {
                 action: job.action.name.clone(),
@@ -563,8 +565,7 @@ pub(crate) fn segment_problem(
     k: usize,
     segment: &PlannedSegment,
 ) -> Result<SegmentProblem, SolveError> {
-    let failed =
-        |source| SolveError::Reference { action: action.name.clone(), segment: k, source };
+    let failed = |source| SolveError::Reference { action: action.name.clone(), segment: k, source };
     let state = ArmState::at(robot, q).map_err(|e| SolveError::Qp {
         action: action.name.clone(),
         segment: k,
@@ -612,7 +613,11 @@ pub(crate) fn segment_problem(
 fn map_fits(job: &Job) -> bool {
     job.problem.space == Space::Cpsa
         && !job.scene.is_empty()
-        && job.problem.components.iter().all(|c| c.variable == Variable::Swivel || c.role == Role::Path)
+        && job
+            .problem
+            .components
+            .iter()
+            .all(|c| c.variable == Variable::Swivel || c.role == Role::Path)
 }
 
 /// A segment as one of the solvers solved it.

@@ -3,8 +3,8 @@
 use super::sphere::{AxialCapsule, ElbowCircle, HalfWidth, half_width};
 use super::{MapError, MapOptions, WristMotion};
 use crate::collision::{CollisionModel, CollisionScene, PosedCapsule, arm_capsules, clearance};
-use crate::kinematics::{IkOptions, arm_pose, ik_cpsa_with, swivel_intervals};
 use crate::kinematics::{CpsaState, SwivelInterval};
+use crate::kinematics::{IkOptions, arm_pose, ik_cpsa_with, swivel_intervals};
 use crate::language::{Obstacle, Shape};
 use crate::math::{JointVector, PI, Real, Vector3, wrap_angle};
 use crate::robot::{LinkRole, Robot};
@@ -115,8 +115,13 @@ struct Models {
 
 /// `robot` with only the capsules `keep` accepts.
 fn with_capsules(robot: &Robot, keep: impl Fn(usize) -> bool) -> Option<Robot> {
-    let capsules: Vec<_> =
-        robot.capsules.iter().enumerate().filter(|(i, _)| keep(*i)).map(|(_, c)| c.clone()).collect();
+    let capsules: Vec<_> = robot
+        .capsules
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| keep(*i))
+        .map(|(_, c)| c.clone())
+        .collect();
     (!capsules.is_empty()).then(|| Robot { capsules, ..robot.clone() })
 }
 
@@ -158,16 +163,19 @@ fn axial_capsules(
         .iter()
         .zip(&robot.capsules)
         .map(|(p, c)| {
-            if !(matches!(c.role, LinkRole::UpperArm | LinkRole::Forearm) && (3..=4).contains(&c.frame))
+            if !(matches!(c.role, LinkRole::UpperArm | LinkRole::Forearm)
+                && (3..=4).contains(&c.frame))
             {
                 return None;
             }
             let (ha, ra, pa) = circle.cylindrical(&p.a);
             let (hb, rb, pb) = circle.cylindrical(&p.b);
             let scale = 1e-9 * (1.0 + ra.max(rb));
-            let same_phase = ra < scale || rb < scale || wrap_angle(pa - pb).abs() * ra.min(rb) < scale;
+            let same_phase =
+                ra < scale || rb < scale || wrap_angle(pa - pb).abs() * ra.min(rb) < scale;
             let phase = if ra >= rb { pa } else { pb };
-            same_phase.then_some((AxialCapsule { a: (ha, ra), b: (hb, rb), radius: c.radius }, phase))
+            same_phase
+                .then_some((AxialCapsule { a: (ha, ra), b: (hb, rb), radius: c.radius }, phase))
         })
         .collect()
 }
@@ -180,7 +188,13 @@ fn cell_angles(n: usize) -> Vec<Real> {
 
 /// IK at a cell without the joint limits (they are labelled from the closed-form
 /// intervals), the branch nearest `near`.
-fn configuration(robot: &Robot, pw: &Vector3, ow: &crate::math::Rotation3, swivel: Real, near: &JointVector) -> Option<JointVector> {
+fn configuration(
+    robot: &Robot,
+    pw: &Vector3,
+    ow: &crate::math::Rotation3,
+    swivel: Real,
+    near: &JointVector,
+) -> Option<JointVector> {
     let unlimited = IkOptions { limit_tolerance: Real::INFINITY, ..IkOptions::default() };
     ik_cpsa_with(robot, &CpsaState { pw: *pw, ow: *ow, swivel }, Some(near), &unlimited)
         .ok()
@@ -279,7 +293,13 @@ pub fn build_map(
                     HalfWidth::Full => PI,
                 };
                 let centre = wrap_angle(phase + angles[0] - phase_o);
-                map.intervals.push(ForbiddenInterval { column: i, obstacle: k, capsule: c, centre, half_width: hw });
+                map.intervals.push(ForbiddenInterval {
+                    column: i,
+                    obstacle: k,
+                    capsule: c,
+                    centre,
+                    half_width: hw,
+                });
                 sphere_hits.push((k, centre, hw));
             }
         }

@@ -19,11 +19,11 @@ pub use spline::{ClampedSpline, SplineError, chord_length_times};
 pub use task::{SegmentMap, SegmentMapError, map_segment, segment_map};
 
 use crate::kinematics::KinematicsError;
-use crate::math::{JointVector, Real, Rotation3, Vector3};
-use crate::profile::{Reference, Sample};
-use crate::profile::Role;
-use crate::solve::qp::SegmentProblem;
 use crate::language::{Space, Variable};
+use crate::math::{JointVector, Real, Rotation3, Vector3};
+use crate::profile::Role;
+use crate::profile::{Reference, Sample};
+use crate::solve::qp::SegmentProblem;
 
 /// Settings of the map and its profile.
 #[derive(Debug, Clone, PartialEq)]

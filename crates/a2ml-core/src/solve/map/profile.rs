@@ -9,7 +9,7 @@ use super::{MapError, MapOptions, SwivelTargets, WristMotion};
 use crate::collision::{CollisionModel, CollisionScene, clearance};
 use crate::kinematics::{CpsaState, arm_pose, cpsa_jacobian, ik_cpsa};
 use crate::language::Obstacle;
-use crate::math::{JointVector, Real, Vector7, wrap_angle};
+use crate::math::{JointVector, PI, Real, Vector7, wrap_angle};
 use crate::robot::Robot;
 use crate::trajectory::Trajectory;
 
@@ -29,6 +29,9 @@ pub struct SwivelProfile {
     /// The programme's cost (velocity, acceleration and reference terms).
     pub cost: Real,
 }
+
+/// Over how many nodes the exact start and goal angles blend into the grid path.
+const FADE_NODES: Real = 8.0;
 
 /// The grid path the dynamic programme found: (map column, unwrapped angle) nodes.
 struct GridPath {
@@ -66,8 +69,7 @@ pub fn plan_profile(
         return Err(MapError::Options("the verification rate must be positive"));
     }
     let pose = arm_pose(robot, start);
-    let start_swivel =
-        crate::kinematics::cpsa_state(robot, &pose).map_err(MapError::Start)?.swivel;
+    let start_swivel = crate::kinematics::cpsa_state(robot, &pose).map_err(MapError::Start)?.swivel;
     let path = search(map, start_swivel, targets, options)?;
     let duration = map.times.last().copied().unwrap_or(0.0);
     let model = CollisionModel::new(robot, &CollisionScene::new(obstacles));
@@ -137,7 +139,8 @@ fn search(
     let j0 = map.angle_index(start_swivel);
     let end_cell = targets.end.map(|e| map.angle_index(e));
     let reference = |i: usize| targets.reference.get(i).copied();
-    let (wv, wa, wr) = (options.velocity_weight, options.acceleration_weight, options.reference_weight);
+    let (wv, wa, wr) =
+        (options.velocity_weight, options.acceleration_weight, options.reference_weight);
     let mut cost = vec![Real::INFINITY; n * width];
     cost[j0 * width + m as usize] = 0.0;
     // back[s][state]: the previous step's index, for the stride ending at columns[s + 1].
@@ -227,13 +230,19 @@ fn search(
     }
     steps.reverse();
     let mut angle = map.angles[j0];
-    let mut nodes = vec![(0, start_swivel)];
+    let mut nodes = vec![(0, angle)];
     for (s, d) in steps.iter().enumerate() {
         angle += *d as Real * step;
         nodes.push((columns[s + 1], angle));
     }
-    if let (Some(end), Some(last)) = (targets.end, nodes.last_mut()) {
-        last.1 += wrap_angle(end - last.1);
+    // The cells' centres are within half a cell of the exact start (and goal); the offset
+    // fades over a few nodes rather than jumping at the first.
+    let start_offset = wrap_angle(start_swivel - nodes[0].1);
+    let end_offset = targets.end.map_or(0.0, |end| wrap_angle(end - angle));
+    let count = nodes.len();
+    for (k, node) in nodes.iter_mut().enumerate() {
+        let fade = |from_end: usize| (1.0 - from_end as Real / FADE_NODES).max(0.0);
+        node.1 += start_offset * fade(k) + end_offset * fade(count - 1 - k);
     }
     Ok(GridPath { nodes, cost: total })
 }
@@ -266,12 +275,16 @@ fn follow(
         let q = ik_cpsa(robot, &target, Some(&near))
             .map_err(|e| fail(e.to_string()))?
             .into_iter()
-            .next()
+            .map(|b| unwrapped_toward(robot, b, &near))
+            .min_by(|a, b| (a - near).norm().total_cmp(&(b - near).norm()))
             .ok_or_else(|| fail("no IK branch".to_owned()))?;
         if k > 0 && (q - near).amax() > 0.2 {
+            let joint = (q - near).iamax();
             return Err(fail(format!(
-                "the IK branch jumps by {:.3} rad between samples",
-                (q - near).amax()
+                "the IK branch jumps by {:.3} rad at joint {} between samples (a joint limit or \
+                 a singularity on the way)",
+                (q - near).amax(),
+                joint + 1
             )));
         }
         let distance = clearance(model, &q);
@@ -283,7 +296,8 @@ fn follow(
             )));
         }
         worst = worst.min(distance);
-        let jacobian = cpsa_jacobian(robot, &arm_pose(robot, &q)).map_err(|e| fail(e.to_string()))?;
+        let jacobian =
+            cpsa_jacobian(robot, &arm_pose(robot, &q)).map_err(|e| fail(e.to_string()))?;
         let mut rate = Vector7::zeros();
         rate.fixed_rows_mut::<3>(0).copy_from(&wrist.velocity);
         rate.fixed_rows_mut::<3>(3).copy_from(&wrist.angular_velocity);
@@ -320,4 +334,18 @@ fn follow(
     let trajectory = Trajectory::new(times, positions, velocities)
         .map_err(|e| MapError::Verification { time: 0.0, why: e.to_string() })?;
     Ok((trajectory, swivel, worst))
+}
+
+/// Each joint of `q` moved by ±2π towards `near` where that keeps it within its limits, so
+/// a joint whose range spans more than a turn is followed continuously.
+fn unwrapped_toward(robot: &Robot, mut q: JointVector, near: &JointVector) -> JointVector {
+    for (i, joint) in robot.joints.iter().enumerate() {
+        let candidates = [q[i], q[i] - 2.0 * PI, q[i] + 2.0 * PI];
+        q[i] = candidates
+            .into_iter()
+            .filter(|v| joint.limits.contains(*v, 1e-9))
+            .min_by(|a, b| (a - near[i]).abs().total_cmp(&(b - near[i]).abs()))
+            .unwrap_or(q[i]);
+    }
+    q
 }

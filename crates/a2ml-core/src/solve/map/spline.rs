@@ -31,7 +31,9 @@ impl Knot for crate::math::Vector3 {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SplineError {
     /// Fewer than two knots, or knots and values of different lengths.
-    #[error("a spline needs at least two knots with one value each (got {times} times, {values} values)")]
+    #[error(
+        "a spline needs at least two knots with one value each (got {times} times, {values} values)"
+    )]
     Knots {
         /// Knot times given.
         times: usize,
