@@ -10,6 +10,7 @@ mod ik;
 mod jacobians;
 mod language;
 mod metrics;
+mod map;
 mod opt;
 mod output;
 mod plan;

@@ -230,6 +230,7 @@ fn solve_error(file: &Path, error: SolveError) -> CliError {
         SolveError::Reference { .. }
         | SolveError::Qp { .. }
         | SolveError::Rrt { .. }
+        | SolveError::Map { .. }
         | SolveError::Trajectory(_) => CliError::Planning(message),
     }
 }

@@ -14,6 +14,7 @@ mod mcap_file;
 mod messages;
 mod read;
 mod schemas;
+mod swivel_map;
 
 #[cfg(test)]
 mod tests;
@@ -24,6 +25,7 @@ pub use atomic::{Staged, refused_kind};
 pub use read::{
     ReadError, RecordedPlan, RecordedSegment, read_csv, read_csv_str, read_mcap, read_mcap_bytes,
 };
+pub use swivel_map::swivel_map_svg;
 
 use crate::language::Task;
 use crate::math::Real;
@@ -161,4 +163,15 @@ pub fn write_csv(path: &Path, robot: &Robot, plan: &Plan) -> Result<(), OutputEr
 /// [`OutputError`] when the file cannot be written; the target is then left untouched.
 pub fn write_json(path: &Path, robot: &Robot, task: &Task, plan: &Plan) -> Result<(), OutputError> {
     atomic::write_atomically(path, |out| json::write(out, robot, task, plan))
+}
+
+/// Writes `text` to `path` through a temporary file (figures, reports).
+///
+/// # Errors
+/// [`OutputError::Io`] when the file cannot be written; the target is then left untouched.
+pub fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
+    atomic::write_atomically(path, |out| {
+        std::io::Write::write_all(out, text.as_bytes())?;
+        Ok(())
+    })
 }

@@ -8,7 +8,8 @@
 
 pub mod constrained_rrt;
 pub mod hamp;
-mod plan;
+pub mod map;
+pub(crate) mod plan;
 pub mod qp;
 mod report;
 pub mod rrt;

@@ -2,6 +2,7 @@
 //! segments (+Tr within an action, +Se between actions) and report on each.
 
 use super::constrained_rrt::{Chart, constrained_rrt, time_constrained};
+use super::map::{MapError, MapOptions, map_segment};
 use super::qp::{self, Component, QpError, QpOptions, SegmentProblem};
 use super::report::{Fallback, Plan, QpStats, SegmentReport, VariableError};
 use super::rrt::{RrtError, RrtOptions, RrtStats, TimedPath, rrt_connect, time_parameterise};
@@ -26,6 +27,8 @@ pub struct PlanOptions {
     pub qp: QpOptions,
     /// RRT-Connect (its seed and clearance come from the task and `qp.safety_distance`).
     pub rrt: RrtOptions,
+    /// The swivel map (its safety distance comes from `qp.safety_distance`).
+    pub map: MapOptions,
     /// Solver for every segment, overriding the task and its actions.
     pub solver: Option<SolverChoice>,
     /// Output rate (Hz), overriding the task's `settings { rate }`.
@@ -68,7 +71,7 @@ pub enum SolveError {
     /// The solver asked for does not exist yet for this kind of segment.
     #[error(
         "action `{action}`: solver `{}` is not available yet for pattern-{} segments; use \
-         `auto`, `qp` or `rrt`",
+         `auto`, `qp`, `rrt` or `map`",
         solver.name(),
         pattern.number()
     )]
@@ -89,6 +92,16 @@ pub enum SolveError {
         segment: usize,
         /// Why.
         source: RrtError,
+    },
+    /// The swivel map found no profile (asked for explicitly).
+    #[error("action `{action}`, segment {}: map: {source}", segment + 1)]
+    Map {
+        /// The action.
+        action: String,
+        /// Segment index (0-based).
+        segment: usize,
+        /// Why.
+        source: MapError,
     },
     /// A segment's references cannot be built.
     #[error("action `{action}`, segment {}: {source}", segment + 1)]
@@ -242,7 +255,7 @@ impl Solver<'_> {
         let mut joined: Option<Trajectory> = None;
         let mut last: Option<(Real, Real)> = None; // (start, duration) of the previous segment
         for (k, segment) in action.segments.iter().enumerate() {
-            let problem = self.problem(action, k, segment)?;
+            let problem = segment_problem(self.robot, &self.q, action, k, segment)?;
             let chart = Chart::new(self.robot, &problem);
             // A hard path gives the segments that carry it their path primitives; the
             // decomposition's holds are kept as exactly by every solver, hard or not.
@@ -321,6 +334,15 @@ impl Solver<'_> {
                     (_, _, true) => Fallback::QpStalled,
                     _ => Fallback::QpMissedGoal,
                 };
+                if map_fits(job) {
+                    match self.map(job) {
+                        Ok(map) if map.reached && map.path_kept => {
+                            return Ok(Solved { fallback: Some(why), ..map });
+                        }
+                        Ok(_) | Err(SolveError::Map { .. }) => {}
+                        Err(e) => return Err(e),
+                    }
+                }
                 match self.constrained(job) {
                     Ok(rrt) if rrt.reached && rrt.path_kept => {
                         Ok(Solved { fallback: Some(why), ..rrt })
@@ -343,6 +365,7 @@ impl Solver<'_> {
             SolverChoice::Auto => self.qp(job),
             SolverChoice::Rrt if pattern == SegmentPattern::Goal => self.rrt(job),
             SolverChoice::Rrt => self.constrained(job),
+            SolverChoice::Map => self.map(job),
             solver => Err(SolveError::UnsupportedSolver {
                 action: job.action.name.clone(),
                 solver,
@@ -404,6 +427,42 @@ impl Solver<'_> {
         Ok(self.timed(job, timed, path.stats))
     }
 
+    /// A CPSA segment by the swivel map: Pw and Ow follow their references exactly, θsw the
+    /// smoothest free profile (to its goal, if it has one), joints by analytic IK.
+    fn map(&mut self, job: &Job) -> Result<Solved, SolveError> {
+        let obstacles = self.task.action_scene(job.action.index);
+        let options = MapOptions {
+            safety_distance: self.options.qp.safety_distance,
+            ..self.options.map.clone()
+        };
+        let (_, profile) = map_segment(self.robot, &obstacles, &job.problem, &self.q, &options)
+            .map_err(|source| SolveError::Map {
+                action: job.action.name.clone(),
+                segment: job.k,
+                source,
+            })?;
+        let trajectory = profile.trajectory;
+        let end = trajectory.positions().last().copied().unwrap_or(self.q);
+        let errors = end_errors(self.robot, &job.problem, &end);
+        let tolerance = &self.options.qp.tolerance;
+        let reached =
+            job.problem.components.iter().zip(errors).all(|(c, e)| e <= tolerance.of(c.variable));
+        let (path_errors, path_kept) = self.assess(job, &trajectory);
+        Ok(Solved {
+            solver: SolverChoice::Map,
+            trajectory,
+            errors,
+            path_errors,
+            path_kept,
+            settle: 0.0,
+            reached,
+            stalled: false,
+            qp: QpStats::default(),
+            rrt: None,
+            fallback: None,
+        })
+    }
+
     fn rrt_options(&self) -> RrtOptions {
         RrtOptions {
             seed: self.task.settings.seed,
@@ -462,57 +521,6 @@ impl Solver<'_> {
         (worst, within || !job.hard)
     }
 
-    /// The segment's references, starting from where the arm really is.
-    fn problem(
-        &self,
-        action: &PlannedAction,
-        k: usize,
-        segment: &PlannedSegment,
-    ) -> Result<SegmentProblem, SolveError> {
-        let failed =
-            |source| SolveError::Reference { action: action.name.clone(), segment: k, source };
-        let state = ArmState::at(self.robot, &self.q).map_err(|e| SolveError::Qp {
-            action: action.name.clone(),
-            segment: k,
-            source: QpError::Singular { time: 0.0, source: e },
-        })?;
-        let frames = BodyFrames { shoulder_frame: state.hat.shoulder_frame, ow: state.cpsa.ow };
-        let component = |variable: Variable| -> Result<Component, ProfileError> {
-            let start = state.value(variable);
-            let duration = segment.duration;
-            let found = segment
-                .primitives
-                .iter()
-                .find_map(|p| p.variables.iter().position(|v| *v == variable).map(|i| (p, i)));
-            let (reference, role) = match found {
-                Some((p, i)) => match &p.constraint {
-                    PrimitiveConstraint::Goal(targets) => {
-                        (Reference::goal(variable, start, targets[i], duration)?, Role::Goal)
-                    }
-                    PrimitiveConstraint::Path(feature) => {
-                        (Reference::path(variable, start, feature, &frames, duration)?, Role::Path)
-                    }
-                    PrimitiveConstraint::Hold => {
-                        (Reference::hold(variable, start, duration)?, Role::Path)
-                    }
-                },
-                // The decomposition covers the whole space; a gap is held.
-                None => (Reference::hold(variable, start, duration)?, Role::Path),
-            };
-            Ok(Component { variable, reference, role })
-        };
-        let [a, b, c] = segment.space.variables();
-        Ok(SegmentProblem {
-            space: segment.space,
-            components: [
-                component(a).map_err(failed)?,
-                component(b).map_err(failed)?,
-                component(c).map_err(failed)?,
-            ],
-            duration: segment.duration,
-        })
-    }
-
     /// Appends the segment's reference Pw at the output rate, in plan time.
     fn reference(&mut self, problem: &SegmentProblem, start: Real) {
         for t in trajectory::sample_times(0.0, problem.duration, self.rate) {
@@ -563,6 +571,69 @@ impl Solver<'_> {
             fallback: solution.fallback,
         }
     }
+}
+
+/// A segment's references, starting from the arm at `q`.
+pub(crate) fn segment_problem(
+    robot: &Robot,
+    q: &JointVector,
+    action: &PlannedAction,
+    k: usize,
+    segment: &PlannedSegment,
+) -> Result<SegmentProblem, SolveError> {
+    let failed = |source| SolveError::Reference { action: action.name.clone(), segment: k, source };
+    let state = ArmState::at(robot, q).map_err(|e| SolveError::Qp {
+        action: action.name.clone(),
+        segment: k,
+        source: QpError::Singular { time: 0.0, source: e },
+    })?;
+    let frames = BodyFrames { shoulder_frame: state.hat.shoulder_frame, ow: state.cpsa.ow };
+    let component = |variable: Variable| -> Result<Component, ProfileError> {
+        let start = state.value(variable);
+        let duration = segment.duration;
+        let found = segment
+            .primitives
+            .iter()
+            .find_map(|p| p.variables.iter().position(|v| *v == variable).map(|i| (p, i)));
+        let (reference, role) = match found {
+            Some((p, i)) => match &p.constraint {
+                PrimitiveConstraint::Goal(targets) => {
+                    (Reference::goal(variable, start, targets[i], duration)?, Role::Goal)
+                }
+                PrimitiveConstraint::Path(feature) => {
+                    (Reference::path(variable, start, feature, &frames, duration)?, Role::Path)
+                }
+                PrimitiveConstraint::Hold => {
+                    (Reference::hold(variable, start, duration)?, Role::Path)
+                }
+            },
+            // The decomposition covers the whole space; a gap is held.
+            None => (Reference::hold(variable, start, duration)?, Role::Path),
+        };
+        Ok(Component { variable, reference, role })
+    };
+    let [a, b, c] = segment.space.variables();
+    Ok(SegmentProblem {
+        space: segment.space,
+        components: [
+            component(a).map_err(failed)?,
+            component(b).map_err(failed)?,
+            component(c).map_err(failed)?,
+        ],
+        duration: segment.duration,
+    })
+}
+
+/// Whether `auto` may hand the segment to the swivel map (DESIGN.md §5): a CPSA segment that
+/// holds or paths the wrist (Pw and Ow) among obstacles, so that only θsw is left to move.
+fn map_fits(job: &Job) -> bool {
+    job.problem.space == Space::Cpsa
+        && !job.scene.is_empty()
+        && job
+            .problem
+            .components
+            .iter()
+            .all(|c| c.variable == Variable::Swivel || c.role == Role::Path)
 }
 
 /// A segment as one of the solvers solved it.
