@@ -11,6 +11,7 @@ mod language;
 mod opt;
 mod output;
 mod plan;
+mod plot;
 mod profile;
 mod push_box;
 mod robots;

@@ -6,6 +6,8 @@ pub mod check;
 pub mod explain;
 pub mod fmt;
 pub mod plan;
+pub mod plot;
+pub mod report;
 pub mod robot;
 
 use std::path::Path;
@@ -27,6 +29,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Commands::Fmt(args) => fmt::run(&args),
         Commands::Explain(args) => explain::run(&args),
         Commands::Plan(args) => plan::run(&args),
+        Commands::Plot(args) => plot::run(&args),
+        Commands::Report(args) => report::run(&args),
     }
 }
 

@@ -172,7 +172,7 @@ fn outputs(args: &PlanArgs) -> Vec<(Format, PathBuf)> {
 ///
 /// # Errors
 /// [`CliError::Io`] naming the output and its folder.
-fn check_folder(path: &Path) -> Result<(), CliError> {
+pub(crate) fn check_folder(path: &Path) -> Result<(), CliError> {
     match path.parent() {
         Some(folder) if !folder.as_os_str().is_empty() && !folder.is_dir() => Err(CliError::Io(
             format!("cannot write {}: there is no folder {}", path.display(), folder.display()),
@@ -203,7 +203,7 @@ fn output_error(error: OutputError) -> CliError {
 }
 
 /// The exit code of each way planning fails: the input (2) or the solver (4).
-fn solve_error(file: &Path, error: SolveError) -> CliError {
+pub(crate) fn solve_error(file: &Path, error: SolveError) -> CliError {
     let message = format!("{}: {error}", file.display());
     match error {
         SolveError::Decompose(_)

@@ -4,6 +4,7 @@
 mod explain;
 mod language;
 mod plan;
+mod plot;
 mod robot;
 
 use std::fs;

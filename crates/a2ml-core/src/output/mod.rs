@@ -1,7 +1,9 @@
 //! Writing a [`Plan`] to files (DESIGN.md §6): an MCAP recording for Foxglove, a CSV table of
-//! the joint trajectory and the plan as JSON.
+//! the joint trajectory, the plan as JSON, SVG pictures ([`plot`]) and an HTML report
+//! ([`report`]).
 //!
-//! Entry points: [`write_mcap`], [`write_csv`], [`write_json`]. Every writer goes through a
+//! Entry points: [`write_mcap`], [`write_csv`], [`write_json`], [`plot::write_plot`],
+//! [`report::write_report`]. Every writer goes through a
 //! temporary file beside the target, renamed on success and removed on failure, so a failed
 //! run never leaves a partial file. Positions are in {b}, times in the plan's seconds (MCAP:
 //! nanoseconds from the plan's time 0). mcap enters the crate here only.
@@ -11,6 +13,8 @@ mod csv;
 mod json;
 mod mcap_file;
 mod messages;
+pub mod plot;
+pub mod report;
 mod schemas;
 
 #[cfg(test)]
@@ -66,6 +70,14 @@ pub enum OutputError {
         /// The writer's message.
         message: String,
     },
+    /// A picture could not be drawn (see [`plot::PlotError`]).
+    #[error("cannot draw {path}: {message}")]
+    Plot {
+        /// The path as given.
+        path: String,
+        /// The plotting backend's message.
+        message: String,
+    },
     /// A value could not be encoded as JSON.
     #[error("cannot encode JSON for {path}: {message}")]
     Json {
@@ -110,4 +122,15 @@ pub fn write_csv(path: &Path, robot: &Robot, plan: &Plan) -> Result<(), OutputEr
 /// [`OutputError`] when the file cannot be written; the target is then left untouched.
 pub fn write_json(path: &Path, robot: &Robot, task: &Task, plan: &Plan) -> Result<(), OutputError> {
     atomic::write_atomically(path, |out| json::write(out, robot, task, plan))
+}
+
+/// Writes `text` as the file's whole content (an SVG picture, an HTML report).
+///
+/// # Errors
+/// [`OutputError::Io`] when the file cannot be written; the target is then left untouched.
+pub fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
+    atomic::write_atomically(path, |out| {
+        std::io::Write::write_all(out, text.as_bytes())?;
+        Ok(())
+    })
 }
