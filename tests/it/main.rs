@@ -14,6 +14,7 @@ mod map;
 mod opt;
 mod output;
 mod plan;
+mod plot;
 mod profile;
 mod push_box;
 mod repository;

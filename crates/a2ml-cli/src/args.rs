@@ -8,6 +8,8 @@ use crate::commands::check::CheckArgs;
 use crate::commands::explain::ExplainArgs;
 use crate::commands::fmt::FmtArgs;
 use crate::commands::plan::PlanArgs;
+use crate::commands::plot::PlotArgs;
+use crate::commands::report::ReportArgs;
 use crate::commands::robot::RobotArgs;
 
 /// Plans human-like motions for 7-DoF anthropomorphic arms from A2ML tasks.
@@ -23,6 +25,8 @@ Examples:
   a2ml explain examples/type_iv_forward_bar.a2ml
   a2ml plan examples/construct_path_line.a2ml -o lines.mcap
   a2ml analyze lines.mcap
+  a2ml plot examples/type_iv_forward_bar.a2ml -o forward_bar.svg
+  a2ml report examples/push_box_aside_coman.a2ml -o push_box.html
 
 Exit codes: 0 success, 1 I/O error, 2 invalid input, 3 a goal missed (plan
 written), 4 planning failed.")]
@@ -47,6 +51,10 @@ pub enum Commands {
     Plan(PlanArgs),
     /// Measure how human-like a written plan is: RULA, motion patterns, Fitts, bell shape.
     Analyze(AnalyzeArgs),
+    /// Plan a task and draw it as SVG: joints, velocities, featured variables, clearance, wrist path.
+    Plot(PlotArgs),
+    /// Plan a task and write one self-contained HTML report: table, plots, motion playback.
+    Report(ReportArgs),
 }
 
 /// How `robot`, `explain` and `plan` read the arm from its URDF.

@@ -7,6 +7,8 @@ pub mod check;
 pub mod explain;
 pub mod fmt;
 pub mod plan;
+pub mod plot;
+pub mod report;
 pub mod robot;
 
 use std::path::Path;
@@ -30,6 +32,8 @@ pub fn run(cli: Cli, temporaries: &Temporaries) -> Result<(), CliError> {
         Commands::Explain(args) => explain::run(&args),
         Commands::Plan(args) => plan::run(&args, temporaries),
         Commands::Analyze(args) => analyze::run(&args),
+        Commands::Plot(args) => plot::run(&args),
+        Commands::Report(args) => report::run(&args),
     }
 }
 

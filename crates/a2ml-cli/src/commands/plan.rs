@@ -194,6 +194,19 @@ fn outputs(args: &PlanArgs) -> Vec<(Format, PathBuf)> {
     outputs
 }
 
+/// Fails early, before a long plan, when an output's folder does not exist.
+///
+/// # Errors
+/// [`CliError::Io`] naming the output and its folder.
+pub(crate) fn check_folder(path: &Path) -> Result<(), CliError> {
+    match path.parent() {
+        Some(folder) if !folder.as_os_str().is_empty() && !folder.is_dir() => Err(CliError::Io(
+            format!("cannot write {}: there is no folder {}", path.display(), folder.display()),
+        )),
+        _ => Ok(()),
+    }
+}
+
 fn write(
     format: Format,
     staged: &mut Staged,
@@ -220,7 +233,7 @@ fn output_error(error: OutputError) -> CliError {
 }
 
 /// The exit code of each way planning fails: the input (2) or the solver (4).
-fn solve_error(file: &Path, error: SolveError) -> CliError {
+pub(crate) fn solve_error(file: &Path, error: SolveError) -> CliError {
     let message = format!("{}: {error}", file.display());
     match error {
         SolveError::Decompose(_)

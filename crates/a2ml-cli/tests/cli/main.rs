@@ -6,6 +6,7 @@ mod explain;
 mod language;
 mod outputs;
 mod plan;
+mod plot;
 mod robot;
 
 use std::fs;

@@ -1,7 +1,9 @@
 //! Writing a [`Plan`] to files (DESIGN.md §6): an MCAP recording for Foxglove, a CSV table of
-//! the joint trajectory and the plan as JSON.
+//! the joint trajectory, the plan as JSON, SVG pictures ([`plot`]) and an HTML report
+//! ([`report`]).
 //!
-//! Entry points: [`write_mcap`], [`write_csv`], [`write_json`]. Every writer goes through a
+//! Entry points: [`write_mcap`], [`write_csv`], [`write_json`], [`plot::write_plot`],
+//! [`report::write_report`]. Every writer goes through a
 //! temporary file beside the target, renamed on success and removed on failure, so a failed
 //! run never leaves a partial file; several outputs can be [`Staged`] first and committed
 //! together ([`fill_mcap`], [`fill_csv`], [`fill_json`]). Only regular files are replaced. Positions are in {b}, times in the plan's seconds (MCAP:
@@ -13,6 +15,8 @@ mod json;
 mod mcap_file;
 mod messages;
 mod read;
+pub mod plot;
+pub mod report;
 mod schemas;
 mod swivel_map;
 
@@ -82,6 +86,14 @@ pub enum OutputError {
         /// The path as given.
         path: String,
         /// The writer's message.
+        message: String,
+    },
+    /// A picture could not be drawn (see [`plot::PlotError`]).
+    #[error("cannot draw {path}: {message}")]
+    Plot {
+        /// The path as given.
+        path: String,
+        /// The plotting backend's message.
         message: String,
     },
     /// A value could not be encoded as JSON.

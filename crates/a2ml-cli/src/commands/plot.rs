@@ -1,0 +1,114 @@
+//! `a2ml plot`: plans a task file (as `a2ml plan` does) and draws the plan as an SVG picture
+//! through the core's [`output::plot`](a2ml_core::output::plot): one kind of chart, or every
+//! kind on one page.
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use clap::builder::{PossibleValuesParser, TypedValueParser};
+
+use a2ml_core::Robot;
+use a2ml_core::language::Task;
+use a2ml_core::output::plot::{PlotKind, write_plot};
+use a2ml_core::solve::{self, Plan, PlanOptions};
+
+use crate::error::CliError;
+use crate::output;
+
+/// Arguments of `a2ml plot`.
+#[derive(Debug, Args)]
+#[command(after_help = "\
+Examples:
+  a2ml plot examples/type_iv_forward_bar.a2ml -o forward_bar.svg
+  a2ml plot task.a2ml -o joints.svg --kind joints
+
+Kinds: joints (positions, limits shaded, segment boundaries numbered),
+velocities (and accelerations, against the speed limits), featured (each
+segment's featured variables against their reference and goal), distances
+(each arm capsule to each obstacle, with the safety distance), wrist (the
+wrist path in three orthographic views), all (every kind on one page).
+
+Exit codes: 0 success, 1 a file cannot be read or written, 2 the task or an
+option is not valid, 3 a goal is missed beyond tolerance (the picture is
+written all the same), 4 the solver failed (nothing is written).")]
+pub struct PlotArgs {
+    /// The task file (it is planned first).
+    #[arg(value_name = "TASK.a2ml")]
+    pub file: PathBuf,
+    /// The SVG file to write.
+    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
+    pub output: PathBuf,
+    /// What to draw.
+    #[arg(long, value_name = "KIND", default_value = "all", value_parser = kind_parser())]
+    pub kind: PlotKind,
+    /// Seed of the randomised solvers, overriding the task's `settings { seed }`.
+    #[arg(long, value_name = "N")]
+    pub seed: Option<u64>,
+}
+
+/// `--kind`: one of [`PlotKind::NAMES`], listed in `--help`.
+fn kind_parser() -> impl TypedValueParser<Value = PlotKind> {
+    PossibleValuesParser::new(PlotKind::NAMES.map(|(name, _)| name))
+        .map(|name| PlotKind::from_name(&name).unwrap_or(PlotKind::All))
+}
+
+/// A task file, its robot and its plan.
+pub struct Planned {
+    /// The robot.
+    pub robot: Robot,
+    /// The validated task.
+    pub task: Task,
+    /// The task file's text.
+    pub source: String,
+    /// The plan.
+    pub plan: Plan,
+}
+
+/// Loads and plans the task file with the default options (and `seed`, if given), the
+/// warnings going to stderr.
+///
+/// # Errors
+/// As `a2ml plan`: [`CliError::Io`], [`CliError::Input`] or [`CliError::Planning`].
+pub fn plan_file(file: &Path, seed: Option<u64>) -> Result<Planned, CliError> {
+    let (mut task, source) = super::load_task(file)?;
+    if let Some(seed) = seed {
+        task.settings.seed = seed;
+    }
+    let robot = Robot::from_urdf_file(&task.robot)?;
+    let plan = solve::plan(&robot, &task, &PlanOptions::default())
+        .map_err(|e| super::plan::solve_error(file, e))?;
+    for warning in &plan.warnings {
+        output::warn(warning);
+    }
+    Ok(Planned { robot, task, source, plan })
+}
+
+/// [`CliError::Missed`] when the plan misses a goal or leaves a hard path: `what` was
+/// written all the same.
+///
+/// # Errors
+/// As said.
+pub fn missed(plan: &Plan, what: &str) -> Result<(), CliError> {
+    let failed = plan.segments.iter().filter(|s| !s.reached || !s.path_kept).count();
+    if failed == 0 {
+        return Ok(());
+    }
+    Err(CliError::Missed(format!(
+        "{failed} of {} missed a goal or left a hard path; {what} was written all the same",
+        output::count(plan.segments.len(), "segment")
+    )))
+}
+
+/// Runs `a2ml plot`.
+///
+/// # Errors
+/// As [`plan_file`]; [`CliError::Io`] when the picture cannot be written;
+/// [`CliError::Missed`] when the plan, drawn all the same, misses a goal.
+pub fn run(args: &PlotArgs) -> Result<(), CliError> {
+    super::plan::check_folder(&args.output)?;
+    let planned = plan_file(&args.file, args.seed)?;
+    write_plot(&args.output, &planned.robot, &planned.task, &planned.plan, args.kind)
+        .map_err(|e| CliError::Io(e.to_string()))?;
+    output::print(&format!("wrote  {}\n", args.output.display()))?;
+    missed(&planned.plan, "the picture")
+}
