@@ -3,10 +3,16 @@
 //! Entry points: [`plan`] (a task to a [`Plan`]: trajectory and one [`SegmentReport`] per
 //! segment), [`qp::solve_segment`] (one segment with the velocity QP) and
 //! [`rrt::rrt_connect`] (a collision-free joint-space path) and
-//! [`constrained_rrt::constrained_rrt`] (one that keeps a segment's path constraint exactly).
+//! [`constrained_rrt::constrained_rrt`] (one that keeps a segment's path constraint exactly);
+//! the baselines [`gpm`], [`clik`] and [`pmp`], each a resolver of the velocity loop in
+//! [`control`].
 
+pub mod clik;
 pub mod constrained_rrt;
+pub mod control;
+pub mod gpm;
 mod plan;
+pub mod pmp;
 pub mod qp;
 mod report;
 pub mod rrt;
