@@ -4,6 +4,7 @@
 use clap::{Parser, Subcommand};
 
 use crate::commands::check::CheckArgs;
+use crate::commands::compare::CompareArgs;
 use crate::commands::explain::ExplainArgs;
 use crate::commands::fmt::FmtArgs;
 use crate::commands::plan::PlanArgs;
@@ -21,6 +22,7 @@ Examples:
   a2ml fmt --write task.a2ml
   a2ml explain examples/type_iv_forward_bar.a2ml
   a2ml plan examples/construct_path_line.a2ml -o lines.mcap
+  a2ml compare examples/baseline_pmp.a2ml --solvers qp,pmp
 
 Exit codes: 0 success, 1 I/O error, 2 invalid input, 3 a goal missed (plan
 written), 4 planning failed.")]
@@ -43,4 +45,6 @@ pub enum Commands {
     Explain(ExplainArgs),
     /// Plan a task's motion and write it as MCAP (for Foxglove), CSV or JSON.
     Plan(PlanArgs),
+    /// Plan one task with several solvers (the baselines among them) and compare the results.
+    Compare(CompareArgs),
 }

@@ -3,6 +3,7 @@
 //! [`load_task`] is how the commands that take one task file read it.
 
 pub mod check;
+pub mod compare;
 pub mod explain;
 pub mod fmt;
 pub mod plan;
@@ -27,6 +28,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Commands::Fmt(args) => fmt::run(&args),
         Commands::Explain(args) => explain::run(&args),
         Commands::Plan(args) => plan::run(&args),
+        Commands::Compare(args) => compare::run(&args),
     }
 }
 

@@ -68,7 +68,7 @@ pub struct PlanArgs {
 }
 
 /// `--solver`: one of [`SolverChoice::NAMES`], listed in `--help`.
-fn solver_parser() -> impl TypedValueParser<Value = SolverChoice> {
+pub(crate) fn solver_parser() -> impl TypedValueParser<Value = SolverChoice> {
     PossibleValuesParser::new(SolverChoice::NAMES.map(|(name, _)| name)).map(|name| {
         SolverChoice::NAMES
             .iter()
@@ -212,6 +212,7 @@ fn solve_error(file: &Path, error: SolveError) -> CliError {
         SolveError::Reference { .. }
         | SolveError::Qp { .. }
         | SolveError::Rrt { .. }
+        | SolveError::Baseline { .. }
         | SolveError::Trajectory(_) => CliError::Planning(message),
     }
 }

@@ -57,8 +57,11 @@ pub struct ClikOptions {
     pub wrist_height: HeightTarget,
     /// k_e = k_w (1/s), the layers' gain, default 200.
     pub layer_gain: Real,
-    /// λ² in a layer's inverse (ãW⁻¹ãᵀ + λ²)⁻¹ (m²), default 1e-6: bounded steps where a
-    /// height can no longer be changed without moving the pen.
+    /// The fastest height change a layer asks for (m/s), default 0.5: with k = 200 s⁻¹ a
+    /// centimetre's error would ask for 2 m/s (a project choice).
+    pub layer_speed: Real,
+    /// λ² in a layer's inverse (ãW⁻¹ãᵀ + λ²)⁻¹ (m²/rad²), default 1e-4: bounded steps where
+    /// a height can no longer be changed without moving the pen.
     pub layer_damping: Real,
     /// k_a (1/s) of the remaining null-space motion q'_a = k_a ∂G/∂q, G = -(1/2n) Σ ((q_i -
     /// q̄_i)/(q_iM - q_im))², default 1 (METHODS.md §4.3). The paper's G tracks the layers'
@@ -79,7 +82,8 @@ impl Default for ClikOptions {
             elbow_height: HeightTarget::AbovePen(0.05),
             wrist_height: HeightTarget::AbovePen(0.03),
             layer_gain: 200.0,
-            layer_damping: 1e-6,
+            layer_speed: 0.5,
+            layer_damping: 1e-4,
             null_space_gain: 1.0,
             freeze_null_space: false,
         }
@@ -206,9 +210,13 @@ impl Resolver for Clik {
             ),
             (self.elbow_target, (point_jacobian(pose, 3, &pose.elbow).transpose() * n, pose.elbow)),
         ];
+        // The heights are part of the task: settling waits for them too, or for their stall.
+        let mut worst = error.norm();
         for (height, (row, point)) in layers {
             if let Some(height) = height {
-                let v = o.layer_gain * (height - n.dot(&point));
+                worst = worst.max((height - n.dot(&point)).abs());
+                let v =
+                    (o.layer_gain * (height - n.dot(&point))).clamp(-o.layer_speed, o.layer_speed);
                 (velocity, projector) =
                     prioritised(&velocity, &projector, &row, v, &o.beta, o.layer_damping);
             }
@@ -216,7 +224,7 @@ impl Resolver for Clik {
         let ascent = (q - self.centre).component_mul(&self.range_weights) * -o.null_space_gain;
         let ascent = if o.freeze_null_space { ascent.component_mul(&o.beta) } else { ascent };
         velocity += projector * ascent;
-        Ok(Resolved { velocity, error: error.norm() / self.tolerance.position })
+        Ok(Resolved { velocity, error: worst / self.tolerance.position })
     }
 }
 

@@ -57,6 +57,10 @@ pub struct ControlOptions {
     pub stall_fraction: Real,
     /// Rate (1/s) at which q' decays to rest after the loop stopped while moving, default 20.
     pub brake_rate: Real,
+    /// Time (s) over which q' is faded in from rest at the start, ½(1 - cos(π t/ramp)),
+    /// default 0: the resolver's formula as it is. Velocity-level formulas with a null-space
+    /// or elastic term command a velocity at t = 0, which a sequential join (+Se) refuses.
+    pub start_ramp: Real,
     /// When a resolver's task counts as reached.
     pub tolerance: Tolerance,
 }
@@ -71,6 +75,7 @@ impl Default for ControlOptions {
             stall_window: 0.2,
             stall_fraction: 0.01,
             brake_rate: 20.0,
+            start_ramp: 0.0,
             tolerance: Tolerance::default(),
         }
     }
@@ -78,9 +83,11 @@ impl Default for ControlOptions {
 
 /// The settings of the three baselines and their loop, one field of
 /// [`super::PlanOptions`].
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct BaselineOptions {
-    /// The control loop (its tolerance is replaced by the plan's).
+    /// The control loop (its tolerance is replaced by the plan's); by default its
+    /// `start_ramp` is 0.1 s, so that every segment starts from rest as the actions' +Se
+    /// joins need.
     pub control: ControlOptions,
     /// The gradient projection method.
     pub gpm: GpmOptions,
@@ -88,6 +95,17 @@ pub struct BaselineOptions {
     pub clik: ClikOptions,
     /// λ0-PMP and its variants.
     pub pmp: PmpOptions,
+}
+
+impl Default for BaselineOptions {
+    fn default() -> Self {
+        Self {
+            control: ControlOptions { start_ramp: 0.1, ..ControlOptions::default() },
+            gpm: GpmOptions::default(),
+            clik: ClikOptions::default(),
+            pmp: PmpOptions::default(),
+        }
+    }
 }
 
 /// Why a resolver-based segment cannot be solved.
@@ -176,6 +194,7 @@ fn check_options(o: &ControlOptions) -> Result<(), ControlError> {
         (positive(o.stall_window), "the stall window must be positive"),
         (positive(o.stall_fraction) && o.stall_fraction < 1.0, "stall fraction out of (0, 1)"),
         (positive(o.brake_rate) && o.brake_rate * o.step < 1.0, "brake rate out of range"),
+        (o.start_ramp.is_finite() && o.start_ramp >= 0.0, "negative start ramp"),
     ];
     match checks.iter().find(|(ok, _)| !ok) {
         Some((_, reason)) => Err(ControlError::InvalidOptions { reason }),
@@ -206,7 +225,14 @@ pub fn run(
     let h = duration / steps as Real;
     let settle_steps = (options.max_settle / h).ceil() as usize;
     let window = ((options.stall_window / h).ceil() as usize).max(1);
-    let mut call = |q: &JointVector, t: Real| resolver.resolve(&arm_pose(robot, q), q, t);
+    let ramp = options.start_ramp;
+    let mut call = |q: &JointVector, t: Real| {
+        let mut resolved = resolver.resolve(&arm_pose(robot, q), q, t)?;
+        if t < ramp {
+            resolved.velocity *= 0.5 * (1.0 - (std::f64::consts::PI * t / ramp).cos());
+        }
+        Ok::<Resolved, ControlError>(resolved)
+    };
 
     let (mut times, mut positions, mut velocities) = (Vec::new(), Vec::new(), Vec::new());
     let mut progress: Vec<Real> = Vec::new();

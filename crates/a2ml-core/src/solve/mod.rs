@@ -8,6 +8,7 @@
 //! [`control`].
 
 pub mod clik;
+pub mod compare;
 pub mod constrained_rrt;
 pub mod control;
 pub mod gpm;
