@@ -1,5 +1,6 @@
 //! Integration tests of the a2ml library, one module per area.
 
+mod baselines;
 mod collision;
 mod common;
 mod constrained_rrt;

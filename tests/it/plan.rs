@@ -227,9 +227,9 @@ fn bad_settings_and_unavailable_solvers_are_errors() {
     let options = PlanOptions { rate: Some(0.0), ..PlanOptions::default() };
     assert!(matches!(plan(&robot, &task, &options), Err(SolveError::InvalidRate { .. })));
     let options =
-        PlanOptions { solver: Some(language::SolverChoice::Pmp), ..PlanOptions::default() };
-    let message = plan(&robot, &task, &options).expect_err("no pmp yet").to_string();
-    assert!(message.contains("solver `pmp` is not available yet"), "{message}");
+        PlanOptions { solver: Some(language::SolverChoice::Map), ..PlanOptions::default() };
+    let message = plan(&robot, &task, &options).expect_err("no map yet").to_string();
+    assert!(message.contains("solver `map` is not available yet"), "{message}");
 }
 
 #[test]

@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 
 use crate::commands::analyze::AnalyzeArgs;
 use crate::commands::check::CheckArgs;
+use crate::commands::compare::CompareArgs;
 use crate::commands::explain::ExplainArgs;
 use crate::commands::fmt::FmtArgs;
 use crate::commands::plan::PlanArgs;
@@ -27,6 +28,7 @@ Examples:
   a2ml analyze lines.mcap
   a2ml plot examples/type_iv_forward_bar.a2ml -o forward_bar.svg
   a2ml report examples/push_box_aside_coman.a2ml -o push_box.html
+  a2ml compare examples/baseline_pmp.a2ml --solvers qp,pmp
 
 Exit codes: 0 success, 1 I/O error, 2 invalid input, 3 a goal missed (plan
 written), 4 planning failed.")]
@@ -55,6 +57,8 @@ pub enum Commands {
     Plot(PlotArgs),
     /// Plan a task and write one self-contained HTML report: table, plots, motion playback.
     Report(ReportArgs),
+    /// Plan one task with several solvers (the baselines among them) and compare the results.
+    Compare(CompareArgs),
 }
 
 /// How `robot`, `explain` and `plan` read the arm from its URDF.

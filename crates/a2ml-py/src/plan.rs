@@ -72,14 +72,14 @@ pub(crate) fn plan(
 }
 
 /// `task_or_path` as a path, or the TypeError naming what it was.
-fn task_path(value: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
+pub(crate) fn task_path(value: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
     value.extract::<PathBuf>().map_err(|_| {
         let kind = value.get_type().name().map_or_else(|_| "?".to_owned(), |n| n.to_string());
         PyTypeError::new_err(format!("task_or_path must be an a2ml.Task or a path, not {kind}"))
     })
 }
 
-fn solver_choice(name: &str) -> PyResult<SolverChoice> {
+pub(crate) fn solver_choice(name: &str) -> PyResult<SolverChoice> {
     SolverChoice::NAMES.iter().find(|(n, _)| *n == name).map(|(_, s)| *s).ok_or_else(|| {
         let names: Vec<&str> = SolverChoice::NAMES.iter().map(|(n, _)| *n).collect();
         PyValueError::new_err(format!("unknown solver '{name}' ({})", names.join(", ")))

@@ -4,6 +4,7 @@
 
 pub mod analyze;
 pub mod check;
+pub mod compare;
 pub mod explain;
 pub mod fmt;
 pub mod plan;
@@ -34,6 +35,7 @@ pub fn run(cli: Cli, temporaries: &Temporaries) -> Result<(), CliError> {
         Commands::Analyze(args) => analyze::run(&args),
         Commands::Plot(args) => plot::run(&args),
         Commands::Report(args) => report::run(&args),
+        Commands::Compare(args) => compare::run(&args),
     }
 }
 

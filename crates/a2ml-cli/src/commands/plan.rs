@@ -76,7 +76,7 @@ pub struct PlanArgs {
 }
 
 /// `--solver`: one of [`SolverChoice::NAMES`], listed in `--help`.
-fn solver_parser() -> impl TypedValueParser<Value = SolverChoice> {
+pub(crate) fn solver_parser() -> impl TypedValueParser<Value = SolverChoice> {
     PossibleValuesParser::new(SolverChoice::NAMES.map(|(name, _)| name)).map(|name| {
         SolverChoice::NAMES
             .iter()
@@ -244,6 +244,7 @@ pub(crate) fn solve_error(file: &Path, error: SolveError) -> CliError {
         | SolveError::Qp { .. }
         | SolveError::Rrt { .. }
         | SolveError::Map { .. }
+        | SolveError::Baseline { .. }
         | SolveError::Trajectory(_) => CliError::Planning(message),
     }
 }

@@ -2,6 +2,7 @@
 //! files written and exit codes.
 
 mod analyze;
+mod compare;
 mod explain;
 mod language;
 mod outputs;

@@ -4,12 +4,19 @@
 //! segment), [`qp::solve_segment`] (one segment with the velocity QP) and
 //! [`rrt::rrt_connect`] (a collision-free joint-space path) and
 //! [`constrained_rrt::constrained_rrt`] (one that keeps a segment's path constraint exactly);
-//! [`hamp::plan_handover`] plans a handover the HAMP way (METHODS.md §3.4).
+//! [`hamp::plan_handover`] plans a handover the HAMP way (METHODS.md §3.4);
+//! the baselines [`gpm`], [`clik`] and [`pmp`], each a resolver of the velocity loop in
+//! [`control`].
 
+pub mod clik;
+pub mod compare;
 pub mod constrained_rrt;
+pub mod control;
+pub mod gpm;
 pub mod hamp;
 pub mod map;
 pub(crate) mod plan;
+pub mod pmp;
 pub mod qp;
 mod report;
 pub mod rrt;

@@ -3,9 +3,11 @@
 
 use super::constrained_rrt::{Chart, constrained_rrt, time_constrained};
 use super::map::{MapError, MapOptions, map_segment};
+use super::control::{BaselineOptions, ControlError, ControlOptions, ControlRun};
 use super::qp::{self, Component, QpError, QpOptions, SegmentProblem};
 use super::report::{Fallback, Plan, QpStats, SegmentReport, VariableError};
 use super::rrt::{RrtError, RrtOptions, RrtStats, TimedPath, rrt_connect, time_parameterise};
+use super::{clik, gpm, pmp};
 use crate::collision::CollisionScene;
 use crate::decompose::{
     ArmState, DecomposeError, DecomposeOptions, PlannedAction, PlannedSegment, SegmentPattern,
@@ -29,6 +31,8 @@ pub struct PlanOptions {
     pub rrt: RrtOptions,
     /// The swivel map (its safety distance comes from `qp.safety_distance`).
     pub map: MapOptions,
+    /// The baselines GPM, CLIK and PMP and their control loop.
+    pub baselines: BaselineOptions,
     /// Solver for every segment, overriding the task and its actions.
     pub solver: Option<SolverChoice>,
     /// Output rate (Hz), overriding the task's `settings { rate }`.
@@ -71,7 +75,7 @@ pub enum SolveError {
     /// The solver asked for does not exist yet for this kind of segment.
     #[error(
         "action `{action}`: solver `{}` is not available yet for pattern-{} segments; use \
-         `auto`, `qp`, `rrt` or `map`",
+         `auto`, `qp`, `rrt`, `map`, `gpm`, `clik` or `pmp`",
         solver.name(),
         pattern.number()
     )]
@@ -122,6 +126,18 @@ pub enum SolveError {
         segment: usize,
         /// Why.
         source: QpError,
+    },
+    /// A baseline (gpm, clik, pmp) failed on a segment.
+    #[error("action `{action}`, segment {}: {}: {source}", segment + 1, solver.name())]
+    Baseline {
+        /// The action.
+        action: String,
+        /// Segment index (0-based).
+        segment: usize,
+        /// The baseline.
+        solver: SolverChoice,
+        /// Why.
+        source: ControlError,
     },
     /// Joining or resampling the segments failed.
     #[error("joining the segments: {0}")]
@@ -366,6 +382,15 @@ impl Solver<'_> {
             SolverChoice::Rrt if pattern == SegmentPattern::Goal => self.rrt(job),
             SolverChoice::Rrt => self.constrained(job),
             SolverChoice::Map => self.map(job),
+            SolverChoice::Gpm => self.baseline(job, SolverChoice::Gpm, |r, p, q, o, c| {
+                gpm::solve_segment(r, p, q, &o.gpm, c)
+            }),
+            SolverChoice::Clik => self.baseline(job, SolverChoice::Clik, |r, p, q, o, c| {
+                clik::solve_segment(r, p, q, &o.clik, c)
+            }),
+            SolverChoice::Pmp => self.baseline(job, SolverChoice::Pmp, |r, p, q, o, c| {
+                pmp::solve_segment(r, p, q, &o.pmp, c)
+            }),
             solver => Err(SolveError::UnsupportedSolver {
                 action: job.action.name.clone(),
                 solver,
@@ -457,6 +482,46 @@ impl Solver<'_> {
             settle: 0.0,
             reached,
             stalled: false,
+            qp: QpStats::default(),
+            rrt: None,
+            fallback: None,
+        })
+    }
+
+    /// A segment by one of the baselines, judged like every other solver: the segment's own
+    /// goal errors, path and limits, whatever the baseline itself tracked.
+    fn baseline(
+        &self,
+        job: &Job,
+        solver: SolverChoice,
+        solve: impl Fn(
+            &Robot,
+            &SegmentProblem,
+            &JointVector,
+            &BaselineOptions,
+            &ControlOptions,
+        ) -> Result<ControlRun, ControlError>,
+    ) -> Result<Solved, SolveError> {
+        let o = &self.options.baselines;
+        let control = ControlOptions { tolerance: self.options.qp.tolerance, ..o.control };
+        let run = solve(self.robot, &job.problem, &self.q, o, &control).map_err(|source| {
+            SolveError::Baseline { action: job.action.name.clone(), segment: job.k, solver, source }
+        })?;
+        let end = run.trajectory.positions().last().copied().unwrap_or(self.q);
+        let errors = end_errors(self.robot, &job.problem, &end);
+        let tolerance = &self.options.qp.tolerance;
+        let reached =
+            job.problem.components.iter().zip(errors).all(|(c, e)| e <= tolerance.of(c.variable));
+        let (path_errors, path_kept) = self.assess(job, &run.trajectory);
+        Ok(Solved {
+            solver,
+            trajectory: run.trajectory,
+            errors,
+            path_errors,
+            path_kept,
+            settle: run.settle,
+            reached,
+            stalled: run.stalled,
             qp: QpStats::default(),
             rrt: None,
             fallback: None,

@@ -627,8 +627,8 @@ def plan(
 
     ``task_or_path`` is a :class:`Task` or the path of a task file (read as
     :func:`load` does). ``solver`` overrides the solver of the task and of
-    every action (default: theirs; ``"auto"`` and ``"qp"`` run the velocity
-    QP, the others are not available yet). ``rate`` (Hz) overrides the task's
+    every action (default: theirs; ``"map"`` is not available yet; ``"gpm"``,
+    ``"clik"`` and ``"pmp"`` are the baselines). ``rate`` (Hz) overrides the task's
     ``settings { rate }`` (default 100 Hz); ``seed`` its ``seed``. ``robot``
     defaults to the task's robot file (:attr:`Task.robot`). A goal missed
     beyond tolerance is not an error: :attr:`Plan.reached` is False and
@@ -642,4 +642,26 @@ def plan(
         UrdfError: the task's robot file cannot be loaded as a 7-DoF arm.
         DecomposeError: the task cannot be decomposed.
         PlanError: the solver is not available yet, or a segment cannot be solved.
+    """
+
+def compare(
+    task_or_path: Task | str | os.PathLike[str],
+    solvers: list[Literal["auto", "qp", "rrt", "map", "gpm", "clik", "pmp"]] | None = None,
+    robot: Robot | None = None,
+) -> list[dict[str, Any]]:
+    """Plan one task with each of ``solvers`` (default ``auto``, ``gpm``,
+    ``clik``, ``pmp``) and return flat records, ``pandas.DataFrame``-ready:
+    one per solver and segment with ``solver``, ``solved_by``, ``action``,
+    ``segment``, ``reached``, ``path_kept``, ``error_<var>`` and
+    ``path_error_<var>`` (m or rad; var Pw, Ow, sw, Os, e), ``limit_margin``
+    (rad, negative = outside) and ``limit_joint``, ``clearance`` (m) and
+    ``clearance_link``, ``peak_speed_ratio``, ``duration`` and
+    ``planning_time`` (s); a solver that produced no plan gives one record
+    whose ``error`` says why. Releases the GIL.
+
+    Raises:
+        TypeError: ``task_or_path`` is neither a Task nor a path.
+        ValueError: a solver is not a solver's name.
+        FileNotFoundError, OSError, ParseError: as :func:`load`.
+        UrdfError: the task's robot file cannot be loaded as a 7-DoF arm.
     """
