@@ -391,11 +391,6 @@ impl Solver<'_> {
             SolverChoice::Pmp => self.baseline(job, SolverChoice::Pmp, |r, p, q, o, c| {
                 pmp::solve_segment(r, p, q, &o.pmp, c)
             }),
-            solver => Err(SolveError::UnsupportedSolver {
-                action: job.action.name.clone(),
-                solver,
-                pattern,
-            }),
         }
     }
 
