@@ -16,4 +16,5 @@ mod push_box;
 mod robots;
 mod rrt;
 mod segments;
+mod smoothness;
 mod swivel;

@@ -13,6 +13,7 @@ pub mod error;
 pub mod kinematics;
 pub mod language;
 pub mod math;
+pub mod metrics;
 pub mod names;
 pub mod output;
 pub mod profile;

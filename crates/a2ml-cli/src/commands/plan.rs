@@ -65,6 +65,26 @@ pub struct PlanArgs {
     /// Seed of the randomised solvers, overriding the task's `settings { seed }`.
     #[arg(long, value_name = "N")]
     pub seed: Option<u64>,
+    /// The joints' acceleration limits as a multiple of the robot file's, overriding the
+    /// task's `settings { acceleration }` (e.g. 0.5).
+    #[arg(long, value_name = "SCALE", value_parser = parse_positive)]
+    pub acceleration_scale: Option<Real>,
+    /// Wall-clock limit of the planning (s) [default: none]: the plan fails with a timeout
+    /// when it passes, so the result then depends on the machine's speed.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_positive)]
+    pub time_limit: Option<Real>,
+}
+
+/// A positive, finite number.
+///
+/// # Errors
+/// A message saying what the number must be.
+fn parse_positive(text: &str) -> Result<Real, String> {
+    match text.trim().parse::<Real>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        Ok(_) => Err("it must be positive and finite".to_owned()),
+        Err(_) => Err("not a number".to_owned()),
+    }
 }
 
 /// `--solver`: one of [`SolverChoice::NAMES`], listed in `--help`.
@@ -115,7 +135,13 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
         task.settings.seed = seed;
     }
     let robot = Robot::from_urdf_file(&task.robot)?;
-    let options = PlanOptions { solver: args.solver, rate: args.rate, ..PlanOptions::default() };
+    let options = PlanOptions {
+        solver: args.solver,
+        rate: args.rate,
+        acceleration_scale: args.acceleration_scale,
+        time_limit: args.time_limit,
+        ..PlanOptions::default()
+    };
 
     let started = Instant::now();
     let mut bar = ProgressBar::new(started);
@@ -136,7 +162,8 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
 
     let missed = plan.segments.iter().filter(|s| !s.reached).count();
     let off_path = plan.segments.iter().filter(|s| !s.path_kept).count();
-    if missed + off_path > 0 {
+    let over = plan.segments.iter().filter(|s| !s.limits_kept).count();
+    if missed + off_path + over > 0 {
         let total = output::count(plan.segments.len(), "segment");
         let mut failures = Vec::new();
         if missed > 0 {
@@ -146,6 +173,9 @@ pub fn run(args: &PlanArgs) -> Result<(), CliError> {
         if off_path > 0 {
             let path = if off_path == 1 { "its hard path" } else { "their hard paths" };
             failures.push(format!("{off_path} of {total} left {path}"));
+        }
+        if over > 0 {
+            failures.push(format!("{over} of {total} exceeded the joint limits"));
         }
         return Err(CliError::Missed(format!(
             "{}; the plan was written all the same",
@@ -208,6 +238,7 @@ fn solve_error(file: &Path, error: SolveError) -> CliError {
     match error {
         SolveError::Decompose(_)
         | SolveError::InvalidRate { .. }
+        | SolveError::InvalidAccelerationScale { .. }
         | SolveError::UnsupportedSolver { .. } => CliError::Input(message),
         SolveError::Reference { .. }
         | SolveError::Qp { .. }
@@ -277,6 +308,7 @@ fn summary(
         output::count(steps, "QP step"),
         num(share, 1),
     ));
+    out.push_str(&worst_rates(plan));
     out
 }
 
@@ -300,6 +332,7 @@ fn goal_error(s: &SegmentReport, tolerance: &Tolerance) -> String {
 /// `auto` went on from the QP, why: `ok (qp stalled)`.
 fn status(s: &SegmentReport) -> String {
     let outcome = match (s.path_kept, s.reached, s.stalled) {
+        _ if !s.limits_kept => "over limits",
         (false, ..) => "off path",
         (true, true, _) => "ok",
         (true, false, true) => "stalled",
@@ -308,6 +341,20 @@ fn status(s: &SegmentReport) -> String {
     match s.fallback {
         Some(why) => format!("{outcome} ({})", why.name()),
         None => outcome.to_owned(),
+    }
+}
+
+/// The worst joint rates against their limits, and which segment has each.
+fn worst_rates(plan: &Plan) -> String {
+    let worst = |rate: fn(&SegmentReport) -> Real| {
+        plan.segments
+            .iter()
+            .max_by(|a, b| rate(a).total_cmp(&rate(b)))
+            .map(|s| format!("{} in `{}` segment {}", num(rate(s), 2), s.action, s.segment + 1))
+    };
+    match (worst(|s| s.peak_velocity_ratio), worst(|s| s.peak_acceleration_ratio)) {
+        (Some(v), Some(a)) => format!("rates  peak |q'|/limit {v}, peak |q''|/limit {a}\n"),
+        _ => String::new(),
     }
 }
 
@@ -416,6 +463,8 @@ mod tests {
             solver: None,
             rate: None,
             seed: None,
+            acceleration_scale: None,
+            time_limit: None,
         };
         assert_eq!(outputs(&args), vec![(Format::Mcap, PathBuf::from("lines.mcap"))]);
         let args = PlanArgs { csv: Some(PathBuf::from("x.csv")), ..args };

@@ -166,7 +166,12 @@ impl<'a> Tree<'a> {
     }
 }
 
-fn limits(joint: &urdf_rs::Joint) -> Result<JointLimits, RobotError> {
+/// A joint's limits; its acceleration limit from `stated` (the robot file's
+/// `a2ml_acceleration` attributes) or the default.
+fn limits(
+    joint: &urdf_rs::Joint,
+    stated: &std::collections::HashMap<String, Real>,
+) -> Result<JointLimits, RobotError> {
     let l = &joint.limit;
     let ok = l.lower.is_finite()
         && l.upper.is_finite()
@@ -181,7 +186,11 @@ fn limits(joint: &urdf_rs::Joint) -> Result<JointLimits, RobotError> {
             velocity: l.velocity,
         });
     }
-    Ok(JointLimits { lower: l.lower, upper: l.upper, velocity: l.velocity })
+    let acceleration = stated
+        .get(&joint.name)
+        .copied()
+        .unwrap_or(super::DEFAULT_ACCELERATION_PER_SECOND * l.velocity);
+    Ok(JointLimits { lower: l.lower, upper: l.upper, velocity: l.velocity, acceleration })
 }
 
 fn unit_axis(joint: &urdf_rs::Joint) -> Result<Vector3, RobotError> {
@@ -251,6 +260,7 @@ pub(super) fn build(
         RobotError::InvalidOption { reason: "the vertical axis must be non-zero".into() }
     })?;
     let tool = hand_rotation(options)?;
+    let accelerations = super::acceleration::stated(text)?;
 
     // Walk the chain in base-link coordinates; shift to {b} once S is known.
     let mut joints: Vec<Joint> = Vec::with_capacity(DOF);
@@ -266,7 +276,7 @@ pub(super) fn build(
                     name: joint.name.clone(),
                     parent_from_joint: acc * pose(&joint.origin),
                     axis: unit_axis(joint)?,
-                    limits: limits(joint)?,
+                    limits: limits(joint, &accelerations)?,
                 });
                 acc = Isometry::identity();
             }

@@ -4,12 +4,16 @@
 //! segment), [`qp::solve_segment`] (one segment with the velocity QP) and
 //! [`rrt::rrt_connect`] (a collision-free joint-space path) and
 //! [`constrained_rrt::constrained_rrt`] (one that keeps a segment's path constraint exactly).
+//! Their long loops report progress and check the user's wall-clock limit through a
+//! [`monitor::Monitor`]; without a limit, results never depend on the clock.
 
 pub mod constrained_rrt;
+pub mod monitor;
 mod plan;
 pub mod qp;
 mod report;
 pub mod rrt;
 
+pub use monitor::Monitor;
 pub use plan::{PlanOptions, Progress, SolveError, plan, plan_with_progress};
 pub use report::{Fallback, Plan, QpStats, SegmentReport, Tolerance, VariableError};
