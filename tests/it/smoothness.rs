@@ -189,3 +189,43 @@ fn examples() -> Vec<String> {
     names.sort();
     names
 }
+
+/// Panda's file states Franka's acceleration limits; COMAN's states none, so it gets the
+/// default; a bad value is an error naming the joint.
+#[test]
+fn acceleration_limits_come_from_the_robot_file_or_the_default() {
+    let panda = common::load("panda");
+    let franka = [15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0];
+    assert_eq!(panda.acceleration_limits().as_slice(), &franka);
+    let coman = common::load("coman_right_arm");
+    let default = coman.velocity_limits() * a2ml::robot::DEFAULT_ACCELERATION_PER_SECOND;
+    assert_eq!(coman.acceleration_limits(), default);
+    let text = std::fs::read_to_string(common::robot_path("panda")).expect("reads");
+    let bad = text.replacen("a2ml_acceleration=\"7.5\"", "a2ml_acceleration=\"fast\"", 1);
+    match Robot::from_urdf_str(&bad, &a2ml::RobotOptions::default()) {
+        Err(a2ml::RobotError::InvalidAcceleration { joint, text }) => {
+            assert_eq!((joint.as_str(), text.as_str()), ("panda_joint2", "fast"));
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// A wall-clock limit is the user's option: when it passes, the plan fails with a timeout.
+/// Without it, the RRT's plan, counters and messages are the same on every run.
+#[test]
+fn time_limits_are_optional_and_results_repeat_without_one() {
+    let task = language::load(common::example("type_iv_forward_bar.a2ml")).expect("loads");
+    let robot = Robot::from_urdf_file(&task.robot).expect("robot");
+    let options = PlanOptions { time_limit: Some(1e-9), ..PlanOptions::default() };
+    let error = plan(&robot, &task, &options).expect_err("the limit has passed");
+    assert!(error.to_string().contains("timeout"), "{error}");
+    let a = plan(&robot, &task, &PlanOptions::default()).expect("plans");
+    let b = plan(&robot, &task, &PlanOptions::default()).expect("plans");
+    assert_eq!(a.trajectory, b.trajectory);
+    assert_eq!(a.warnings, b.warnings);
+    let counters = |p: &Plan| -> Vec<Option<(usize, usize, usize)>> {
+        p.segments.iter().map(|s| s.rrt.map(|r| (r.samples, r.nodes, r.collision_checks))).collect()
+    };
+    assert_eq!(counters(&a), counters(&b));
+    assert!(counters(&a).iter().any(Option::is_some), "the forward bar uses the RRT");
+}
