@@ -22,4 +22,5 @@ mod repository;
 mod robots;
 mod rrt;
 mod segments;
+mod smoothness;
 mod swivel;

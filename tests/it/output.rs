@@ -73,6 +73,13 @@ fn report(action: &str, index: usize, start: Real, end: Real) -> SegmentReport {
         qp: QpStats { steps: 40, ..QpStats::default() },
         rrt: None,
         fallback: (index == 1).then_some(Fallback::QpStalled),
+        peak_velocity_ratio: 0.5,
+        peak_acceleration_ratio: 0.25,
+        limits_kept: true,
+        slowed_down: 1.0,
+        joint_jerk: 20.0,
+        wrist_jerk: 19.0,
+        speed_peaks: 1,
     }
 }
 

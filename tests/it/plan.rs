@@ -261,12 +261,19 @@ fn progress_is_reported_after_every_segment() {
     let robot = Robot::from_urdf_file(&task.robot).expect("robot");
     let mut seen = Vec::new();
     let plan = a2ml::solve::plan_with_progress(&robot, &task, &PlanOptions::default(), &mut |p| {
-        seen.push((p.done, p.total))
+        seen.push((p.done, p.total, p.fraction, p.overall()))
     })
     .expect("plans");
     let total = plan.segments.len();
-    let expected: Vec<(usize, usize)> = (1..=total).map(|done| (done, total)).collect();
-    assert_eq!(seen, expected);
+    assert!(seen.iter().all(|s| s.1 == total));
+    // Never backwards, from 0 to the end, and within segments too (from inside the QP loop).
+    assert!(seen.windows(2).all(|w| w[1].3 >= w[0].3), "{seen:?}");
+    assert_eq!((seen[0].0, seen[0].3), (0, 0.0));
+    assert_eq!(seen.last().map(|s| (s.0, s.3)), Some((total, 1.0)));
+    assert!(seen.iter().any(|s| s.2 > 0.0 && s.2 < 1.0), "no progress within a segment");
+    for done in 1..=total {
+        assert!(seen.iter().any(|s| s.0 == done && s.2 == 0.0), "segment {done} not reported");
+    }
 }
 
 #[test]

@@ -313,7 +313,7 @@ task t {
     e = info.value
     assert e.errors == [
         (1, 8, f"robot file not found: {TESTS_DIR / 'nothere.urdf'}"),
-        (2, 12, "unknown setting `rat` (rate, solver, seed, transition, frame)"),
+        (2, 12, "unknown setting `rat` (rate, solver, seed, transition, frame, acceleration)"),
         (5, 10, "unknown state variable `θs`"),
         (6, 18, "the line direction must not be zero"),
     ]

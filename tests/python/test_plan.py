@@ -188,6 +188,22 @@ def test_rate_and_seed() -> None:
     assert slow.reached
 
 
+def test_rates_within_the_limits_and_a_lower_acceleration_limit() -> None:
+    full = a2ml.plan(EXAMPLE)
+    quarter = a2ml.plan(EXAMPLE, acceleration_scale=0.25, time_limit=600.0)
+    for p in (full, quarter):
+        assert p.reached
+        for s in p.segments:
+            assert s.limits_kept
+            assert 0.0 < s.peak_velocity_ratio <= 1.0
+            assert 0.0 < s.peak_acceleration_ratio <= 1.0
+            assert s.speed_peaks >= 1
+            assert s.joint_jerk > 0.0 and s.wrist_jerk > 0.0
+            assert s.slowed_down >= 1.0
+    with pytest.raises(ValueError):
+        a2ml.plan(EXAMPLE, acceleration_scale=-1.0)
+
+
 def test_auto_runs_the_qp() -> None:
     task = a2ml.load(EXAMPLE)
     assert_same_plan(a2ml.plan(task, solver="qp"), a2ml.plan(task, solver="auto"))

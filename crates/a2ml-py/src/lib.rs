@@ -137,7 +137,9 @@ impl From<CoreError> for PyErr {
             Error::Profile(_) | Error::Trajectory(_) => A2mlError::new_err(message),
             Error::Solve(SolveError::Decompose(_)) => DecomposeError::new_err(message),
             // A rate passed to `plan` (the task's own is validated when parsed).
-            Error::Solve(SolveError::InvalidRate { .. }) => PyValueError::new_err(message),
+            Error::Solve(
+                SolveError::InvalidRate { .. } | SolveError::InvalidAccelerationScale { .. },
+            ) => PyValueError::new_err(message),
             Error::Solve(_) => PlanError::new_err(message),
         }
     }

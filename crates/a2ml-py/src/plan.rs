@@ -31,7 +31,10 @@ type Dict<'py> = Bound<'py, PyDict>;
 
 /// Plans a task, or the task file at a path, on its robot (or `robot`), releasing the GIL.
 #[pyfunction]
-#[pyo3(signature = (task_or_path, solver=None, rate=None, seed=None, robot=None))]
+#[pyo3(signature = (
+    task_or_path, solver=None, rate=None, seed=None, robot=None, acceleration_scale=None,
+    time_limit=None
+))]
 pub(crate) fn plan(
     py: Python<'_>,
     task_or_path: &Bound<'_, PyAny>,
@@ -39,6 +42,8 @@ pub(crate) fn plan(
     rate: Option<Real>,
     seed: Option<u64>,
     robot: Option<Bound<'_, PyRobot>>,
+    acceleration_scale: Option<Real>,
+    time_limit: Option<Real>,
 ) -> PyResult<PyPlan> {
     let task = match task_or_path.cast::<PyTask>() {
         Ok(task) => task.clone(),
@@ -47,6 +52,8 @@ pub(crate) fn plan(
     let options = PlanOptions {
         solver: solver.map(solver_choice).transpose()?,
         rate,
+        acceleration_scale,
+        time_limit,
         ..PlanOptions::default()
     };
     let planned_task = match seed {
@@ -403,6 +410,48 @@ impl PySegmentReport {
         self.report.fallback.map(Fallback::key)
     }
 
+    /// The largest |q'| / velocity limit of any joint over the segment's time in the output.
+    #[getter]
+    fn peak_velocity_ratio(&self) -> Real {
+        self.report.peak_velocity_ratio
+    }
+
+    /// The largest |q''| / acceleration limit of any joint over the segment's time in the output.
+    #[getter]
+    fn peak_acceleration_ratio(&self) -> Real {
+        self.report.peak_acceleration_ratio
+    }
+
+    /// Whether the output holds every position, velocity and acceleration limit over the segment.
+    #[getter]
+    fn limits_kept(&self) -> bool {
+        self.report.limits_kept
+    }
+
+    /// The factor the segment was slowed down by to keep the limits (1: as solved).
+    #[getter]
+    fn slowed_down(&self) -> Real {
+        self.report.slowed_down
+    }
+
+    /// The normalised jerk of the joints over the segment (dimensionless).
+    #[getter]
+    fn joint_jerk(&self) -> Real {
+        self.report.joint_jerk
+    }
+
+    /// The normalised jerk of the wrist path over the segment (dimensionless).
+    #[getter]
+    fn wrist_jerk(&self) -> Real {
+        self.report.wrist_jerk
+    }
+
+    /// The number of peaks of the featured variable's speed (1: one bell).
+    #[getter]
+    fn speed_peaks(&self) -> usize {
+        self.report.speed_peaks
+    }
+
     /// The smallest clearance over the segment, or None.
     #[getter]
     fn clearance<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
@@ -485,6 +534,13 @@ impl PySegmentReport {
         d.set_item("qp", self.qp(py)?)?;
         d.set_item("rrt", self.rrt(py)?)?;
         d.set_item("fallback", self.fallback())?;
+        d.set_item("peak_velocity_ratio", self.peak_velocity_ratio())?;
+        d.set_item("peak_acceleration_ratio", self.peak_acceleration_ratio())?;
+        d.set_item("limits_kept", self.limits_kept())?;
+        d.set_item("slowed_down", self.slowed_down())?;
+        d.set_item("joint_jerk", self.joint_jerk())?;
+        d.set_item("wrist_jerk", self.wrist_jerk())?;
+        d.set_item("speed_peaks", self.speed_peaks())?;
         Ok(d)
     }
 
@@ -553,6 +609,13 @@ impl PySegmentReport {
                     found.ok_or_else(|| unknown("fallback", &name))
                 })
                 .transpose()?,
+            peak_velocity_ratio: item(d, "peak_velocity_ratio")?.extract()?,
+            peak_acceleration_ratio: item(d, "peak_acceleration_ratio")?.extract()?,
+            limits_kept: item(d, "limits_kept")?.extract()?,
+            slowed_down: item(d, "slowed_down")?.extract()?,
+            joint_jerk: item(d, "joint_jerk")?.extract()?,
+            wrist_jerk: item(d, "wrist_jerk")?.extract()?,
+            speed_peaks: item(d, "speed_peaks")?.extract()?,
         };
         Ok(Self { report })
     }

@@ -73,6 +73,26 @@ pub struct PlanArgs {
     /// Which chain of the URDF, and where its capsules come from.
     #[command(flatten)]
     pub arm: crate::args::ArmArgs,
+    /// The joints' acceleration limits as a multiple of the robot file's, overriding the
+    /// task's `settings { acceleration }` (e.g. 0.5).
+    #[arg(long, value_name = "SCALE", value_parser = parse_positive)]
+    pub acceleration_scale: Option<Real>,
+    /// Wall-clock limit of the planning (s) [default: none]: the plan fails with a timeout
+    /// when it passes, so the result then depends on the machine's speed.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_positive)]
+    pub time_limit: Option<Real>,
+}
+
+/// A positive, finite number.
+///
+/// # Errors
+/// A message saying what the number must be.
+fn parse_positive(text: &str) -> Result<Real, String> {
+    match text.trim().parse::<Real>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        Ok(_) => Err("it must be positive and finite".to_owned()),
+        Err(_) => Err("not a number".to_owned()),
+    }
 }
 
 /// `--solver`: one of [`SolverChoice::NAMES`], listed in `--help`.
@@ -133,7 +153,13 @@ pub fn run(args: &PlanArgs, temporaries: &Temporaries) -> Result<(), CliError> {
     }
     let robot_options = args.arm.options(task.robot_base.as_deref(), task.robot_tip.as_deref())?;
     let robot = Robot::from_urdf_file_with(&task.robot, &robot_options)?;
-    let options = PlanOptions { solver: args.solver, rate: args.rate, ..PlanOptions::default() };
+    let options = PlanOptions {
+        solver: args.solver,
+        rate: args.rate,
+        acceleration_scale: args.acceleration_scale,
+        time_limit: args.time_limit,
+        ..PlanOptions::default()
+    };
 
     let started = Instant::now();
     let mut bar = ProgressBar::new(started);
@@ -162,7 +188,8 @@ pub fn run(args: &PlanArgs, temporaries: &Temporaries) -> Result<(), CliError> {
 
     let missed = plan.segments.iter().filter(|s| !s.reached).count();
     let off_path = plan.segments.iter().filter(|s| !s.path_kept).count();
-    if missed + off_path > 0 {
+    let over = plan.segments.iter().filter(|s| !s.limits_kept).count();
+    if missed + off_path + over > 0 {
         let total = output::count(plan.segments.len(), "segment");
         let mut failures = Vec::new();
         if missed > 0 {
@@ -172,6 +199,9 @@ pub fn run(args: &PlanArgs, temporaries: &Temporaries) -> Result<(), CliError> {
         if off_path > 0 {
             let path = if off_path == 1 { "its hard path" } else { "their hard paths" };
             failures.push(format!("{off_path} of {total} left {path}"));
+        }
+        if over > 0 {
+            failures.push(format!("{over} of {total} exceeded the joint limits"));
         }
         return Err(CliError::Missed(format!(
             "{}; the plan was written all the same",
@@ -239,6 +269,7 @@ pub(crate) fn solve_error(file: &Path, error: SolveError) -> CliError {
         SolveError::Decompose(_)
         | SolveError::InvalidRate { .. }
         | SolveError::NoArmGeometry { .. }
+        | SolveError::InvalidAccelerationScale { .. }
         | SolveError::UnsupportedSolver { .. } => CliError::Input(message),
         SolveError::Reference { .. }
         | SolveError::Qp { .. }
@@ -310,6 +341,7 @@ fn summary(
         output::count(steps, "QP step"),
         num(share, 1),
     ));
+    out.push_str(&worst_rates(plan));
     out
 }
 
@@ -333,6 +365,7 @@ fn goal_error(s: &SegmentReport, tolerance: &Tolerance) -> String {
 /// `auto` went on from the QP, why: `ok (qp stalled)`.
 fn status(s: &SegmentReport) -> String {
     let outcome = match (s.path_kept, s.reached, s.stalled) {
+        _ if !s.limits_kept => "over limits",
         (false, ..) => "off path",
         (true, true, _) => "ok",
         (true, false, true) => "stalled",
@@ -341,6 +374,20 @@ fn status(s: &SegmentReport) -> String {
     match s.fallback {
         Some(why) => format!("{outcome} ({})", why.name()),
         None => outcome.to_owned(),
+    }
+}
+
+/// The worst joint rates against their limits, and which segment has each.
+fn worst_rates(plan: &Plan) -> String {
+    let worst = |rate: fn(&SegmentReport) -> Real| {
+        plan.segments
+            .iter()
+            .max_by(|a, b| rate(a).total_cmp(&rate(b)))
+            .map(|s| format!("{} in `{}` segment {}", num(rate(s), 2), s.action, s.segment + 1))
+    };
+    match (worst(|s| s.peak_velocity_ratio), worst(|s| s.peak_acceleration_ratio)) {
+        (Some(v), Some(a)) => format!("rates  peak |q'|/limit {v}, peak |q''|/limit {a}\n"),
+        _ => String::new(),
     }
 }
 
@@ -450,6 +497,8 @@ mod tests {
             rate: None,
             seed: None,
             arm: crate::args::ArmArgs::default(),
+            acceleration_scale: None,
+            time_limit: None,
         };
         assert_eq!(outputs(&args), vec![(Format::Mcap, PathBuf::from("lines.mcap"))]);
         let args = PlanArgs { csv: Some(PathBuf::from("x.csv")), ..args };

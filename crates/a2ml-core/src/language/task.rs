@@ -397,6 +397,8 @@ pub struct Settings {
     pub transition: Real,
     /// Frame of positions, default {b}.
     pub frame: PositionFrame,
+    /// The joints' acceleration limits as a fraction of the robot file's, default 1 (100 %).
+    pub acceleration: Real,
 }
 
 impl Default for Settings {
@@ -407,6 +409,7 @@ impl Default for Settings {
             seed: 0,
             transition: 0.2,
             frame: PositionFrame::Base,
+            acceleration: 1.0,
         }
     }
 }

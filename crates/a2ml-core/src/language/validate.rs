@@ -49,7 +49,7 @@ const UNITS: [(&str, Dimension, Real); 10] = [
 const AXES: [&str; 14] =
     ["x", "y", "z", "-x", "-y", "-z", "r", "l", "f", "p", "-r", "-l", "-f", "-p"];
 const SHAPES: [&str; 4] = ["box", "sphere", "capsule", "cylinder"];
-const SETTINGS: [&str; 5] = ["rate", "solver", "seed", "transition", "frame"];
+const SETTINGS: [&str; 6] = ["rate", "solver", "seed", "transition", "frame", "acceleration"];
 
 /// A group of an explicit segment: names as written, variables, constraint.
 type Group = (Vec<Name>, Vec<Variable>, Option<PrimitiveConstraint>);
@@ -1018,13 +1018,28 @@ impl Checker<'_> {
                         }
                     }
                 }
+                ("acceleration", ast::SettingValue::Quantity(q)) => {
+                    if let Some(v) = self.quantity(q, Dimension::Fraction) {
+                        if v > 0.0 && v <= 10.0 {
+                            out.acceleration = v;
+                        } else {
+                            self.error(
+                                q.span,
+                                "the acceleration scale is above 0 and at most 1000 %",
+                            );
+                        }
+                    }
+                }
                 ("frame", ast::SettingValue::Word(w)) => match w.text.as_str() {
                     "base" => out.frame = PositionFrame::Base,
                     "root" => out.frame = PositionFrame::Root,
                     _ => self
                         .error(w.span, format!("the frame is `base` or `root`, not `{}`", w.text)),
                 },
-                (name @ ("rate" | "solver" | "seed" | "transition" | "frame"), value) => {
+                (
+                    name @ ("rate" | "solver" | "seed" | "transition" | "frame" | "acceleration"),
+                    value,
+                ) => {
                     let span = match value {
                         ast::SettingValue::Quantity(q) => q.span,
                         ast::SettingValue::Word(w) => w.span,
@@ -1033,7 +1048,7 @@ impl Checker<'_> {
                         "rate" => "a rate like 100 Hz",
                         "solver" => "a solver name like qp",
                         "seed" => "a whole number",
-                        "transition" => "a percentage like 20 %",
+                        "transition" | "acceleration" => "a percentage like 20 %",
                         _ => "`base` or `root`",
                     };
                     self.error(span, format!("`{name}` takes {expected}"));
@@ -1044,7 +1059,8 @@ impl Checker<'_> {
                     self.error_with_help(
                         s.name.span,
                         format!(
-                            "unknown setting `{other}` (rate, solver, seed, transition, frame)"
+                            "unknown setting `{other}` (rate, solver, seed, transition, frame, \
+                             acceleration)"
                         ),
                         help,
                     );

@@ -399,6 +399,13 @@ pub(super) fn segment() -> Schema {
             "qp_stalled, qp_missed_goal or qp_left_path: why auto went on from the QP to the \
              solver named; null if it did not"
         ),
+           "peak_velocity_ratio": described("number", "largest |q'|/limit over the segment"),
+        "peak_acceleration_ratio": described("number", "largest |q''|/limit over the segment"),
+        "limits_kept": b,
+        "slowed_down": described("number", "factor the segment was slowed by (1: as solved)"),
+        "joint_jerk": described("number", "normalised jerk of the joints (dimensionless)"),
+        "wrist_jerk": described("number", "normalised jerk of the wrist path (dimensionless)"),
+        "speed_peaks": described("integer", "peaks of the featured variable's speed"),
     });
     let required: Vec<&str> =
         fields.as_object().map(|m| m.keys().map(String::as_str).collect()).unwrap_or_default();

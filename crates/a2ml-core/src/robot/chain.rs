@@ -187,8 +187,15 @@ impl<'a> Tree<'a> {
 /// that every angle has a 2π shift inside it with room to move past ±π.
 pub(crate) const CONTINUOUS_RANGE: Real = 2.0 * PI;
 
+/// A joint's limits; its acceleration limit from the robot file's `a2ml_acceleration`
+/// attribute or the default.
 fn limits(joint: &super::urdf::Joint) -> Result<JointLimits, RobotError> {
-    let l = joint.limit.unwrap_or(super::urdf::Limit { lower: 0.0, upper: 0.0, velocity: 0.0 });
+    let l = joint.limit.unwrap_or(super::urdf::Limit {
+        lower: 0.0,
+        upper: 0.0,
+        velocity: 0.0,
+        acceleration: None,
+    });
     let (lower, upper) = match joint.kind {
         JointKind::Continuous => (-CONTINUOUS_RANGE, CONTINUOUS_RANGE),
         _ => (l.lower, l.upper),
@@ -201,7 +208,15 @@ fn limits(joint: &super::urdf::Joint) -> Result<JointLimits, RobotError> {
             velocity: l.velocity,
         });
     }
-    Ok(JointLimits { lower, upper, velocity: l.velocity })
+    let acceleration =
+        l.acceleration.unwrap_or(super::DEFAULT_ACCELERATION_PER_SECOND * l.velocity);
+    if !(acceleration.is_finite() && acceleration > 0.0) {
+        return Err(RobotError::InvalidAcceleration {
+            joint: joint.name.clone(),
+            text: acceleration.to_string(),
+        });
+    }
+    Ok(JointLimits { lower, upper, velocity: l.velocity, acceleration })
 }
 
 fn unit_axis(joint: &super::urdf::Joint) -> Result<Vector3, RobotError> {

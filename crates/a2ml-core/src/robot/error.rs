@@ -110,6 +110,14 @@ pub enum RobotError {
         /// Velocity limit read.
         velocity: Real,
     },
+    /// A joint's `a2ml_acceleration` is not a positive number (rad/s²).
+    #[error("joint `{joint}`: a2ml_acceleration=\"{text}\" is not a positive number (rad/s²)")]
+    InvalidAcceleration {
+        /// Joint name.
+        joint: String,
+        /// The attribute's text.
+        text: String,
+    },
     /// The geometry is not that of a shoulder-elbow-wrist arm.
     #[error(
         "not a shoulder-elbow-wrist arm: {reason}; if the URDF holds such an arm, choose its \

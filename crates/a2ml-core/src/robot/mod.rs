@@ -6,6 +6,7 @@
 //! Every position of the model is in the base frame {b}: the axes of the
 //! chain's base link, the origin at the shoulder centre S (DESIGN.md §2).
 
+mod acceleration;
 mod capsules;
 mod chain;
 mod error;
@@ -15,6 +16,8 @@ mod urdf;
 pub use capsules::{CapsuleSource, DEFAULT_SKELETON_RADIUS, GeometryOptions};
 pub use error::RobotError;
 pub use structure::{ArmStructure, least_squares_point, line_distance};
+
+pub use acceleration::{ATTRIBUTE as ACCELERATION_ATTRIBUTE, DEFAULT_ACCELERATION_PER_SECOND};
 
 use crate::math::{DOF, Isometry, JointVector, Real, Rotation3, Vector3};
 
@@ -27,6 +30,9 @@ pub struct JointLimits {
     pub upper: Real,
     /// Velocity limit (rad/s).
     pub velocity: Real,
+    /// Acceleration limit (rad/s²): the `<limit>` element's `a2ml_acceleration` attribute,
+    /// else [`DEFAULT_ACCELERATION_PER_SECOND`] × `velocity`.
+    pub acceleration: Real,
 }
 
 impl JointLimits {
@@ -253,6 +259,11 @@ impl Robot {
     /// Velocity limits.
     pub fn velocity_limits(&self) -> JointVector {
         JointVector::from_fn(|i, _| self.joints[i].limits.velocity)
+    }
+
+    /// Acceleration limits (rad/s²).
+    pub fn acceleration_limits(&self) -> JointVector {
+        JointVector::from_fn(|i, _| self.joints[i].limits.acceleration)
     }
 
     /// The middle of every joint range.

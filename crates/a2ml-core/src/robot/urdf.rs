@@ -92,6 +92,8 @@ pub(crate) struct Limit {
     pub lower: Real,
     pub upper: Real,
     pub velocity: Real,
+    /// The a2ml extension attribute `a2ml_acceleration` (rad/s²), which ROS readers ignore.
+    pub acceleration: Option<Real>,
 }
 
 /// A `<mimic>` tag: this joint follows `joint` as multiplier × q + offset.
@@ -382,6 +384,7 @@ fn joint(at: &At<'_, '_>) -> Result<Joint, RobotError> {
                 lower: optional_number(&l, "lower")?.unwrap_or(0.0),
                 upper: optional_number(&l, "upper")?.unwrap_or(0.0),
                 velocity: optional_number(&l, "velocity")?.unwrap_or(0.0),
+                acceleration: optional_number(&l, super::acceleration::ATTRIBUTE)?,
             })
         })
         .transpose()?;

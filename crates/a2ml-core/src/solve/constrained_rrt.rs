@@ -34,9 +34,13 @@ use std::time::Instant;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 
+use super::monitor::Monitor;
 use super::qp::SegmentProblem;
 use super::report::Tolerance;
-use super::rrt::{Extension, RrtError, RrtOptions, RrtStats, TimedPath, closest_pair, nearest};
+use super::rrt::{
+    Extension, LIMIT_FRACTION, REPORT_EVERY, RrtError, RrtOptions, RrtStats, TimedPath,
+    closest_pair, nearest,
+};
 use crate::collision::{CollisionModel, CollisionScene, advancement, clearance, motion_bound};
 use crate::decompose::{ArmState, goal_error};
 use crate::kinematics::{CpsaState, HatState, ik_cpsa, ik_hat, swivel_intervals};
@@ -44,7 +48,7 @@ use crate::language::{Space, Target, Variable};
 use crate::math::{JointVector, PI, Real, Rotation3, rotation_distance, rotation_log, wrap_angle};
 use crate::profile::{BellProfile, Reference, Role};
 use crate::robot::Robot;
-use crate::trajectory::{Trajectory, TrajectoryError, sample_times};
+use crate::trajectory::{Limits, Trajectory, TrajectoryError, peaks, sample_times};
 
 /// Largest change of any joint between two consecutive IK solutions along an edge (rad): a
 /// larger one is a switch of IK branch, which the arm cannot follow.
@@ -366,7 +370,8 @@ pub struct ConstrainedPath {
 ///
 /// # Errors
 /// [`RrtError`]: invalid settings, a start in collision or outside the limits, no goal
-/// configuration clear of obstacles, or no path within the sample and time limits.
+/// configuration clear of obstacles, or no path within the sample budget
+/// ([`RrtError::Timeout`] when the time limit passes first).
 pub fn constrained_rrt(
     robot: &Robot,
     scene: &CollisionScene,
@@ -374,7 +379,24 @@ pub fn constrained_rrt(
     start: &JointVector,
     options: &RrtOptions,
 ) -> Result<ConstrainedPath, RrtError> {
+    constrained_rrt_monitored(robot, scene, chart, start, options, &mut Monitor::silent())
+}
+
+/// [`constrained_rrt`], reporting the fraction of the sample budget used to `monitor` and
+/// stopping at its deadline.
+///
+/// # Errors
+/// As [`constrained_rrt`].
+pub fn constrained_rrt_monitored(
+    robot: &Robot,
+    scene: &CollisionScene,
+    chart: &Chart,
+    start: &JointVector,
+    options: &RrtOptions,
+    monitor: &mut Monitor,
+) -> Result<ConstrainedPath, RrtError> {
     super::rrt::check_options(options)?;
+    let mut monitor = monitor.within(options.max_time);
     let started = Instant::now();
     if let Some((i, v)) = robot.limit_violation(start, 0.0) {
         let joint = &robot.joints[i].name;
@@ -406,7 +428,14 @@ pub fn constrained_rrt(
             return Ok(search.finish(path, &mut rng, samples, 2, started));
         }
     }
-    while samples < options.max_samples && started.elapsed().as_secs_f64() < options.max_time {
+    while samples < options.max_samples {
+        if samples % REPORT_EVERY == 0 {
+            if monitor.expired() {
+                let nodes = from_start.nodes.len() + from_goal.nodes.len();
+                return Err(RrtError::Timeout { stats: search.stats(samples, nodes, started) });
+            }
+            monitor.report(samples as Real / options.max_samples as Real);
+        }
         samples += 1;
         let Some((sample, hint)) = chart.sample(robot, &mut rng) else { continue };
         let (grow, other) = if swapped {
@@ -823,17 +852,22 @@ fn on_track(
     Some(q)
 }
 
-/// Times a constrained path with the bell profile/// Times a constrained path with the bell profile (paper eq. 9) along its length (chart length
-/// for edges, joint-space length for self-motions at singular points), at `rate`: every
+/// Times a constrained path at `rate` as one rest-to-rest bell (paper eq. 9) per piece, along
+/// its length (chart length for edges, joint-space length for self-motions at singular
+/// points): speed and acceleration vanish where pieces meet, so nothing steps there. Every
 /// sample on an edge is the IK of a chart point on the path, tracked on the path's branch, so
 /// the path constraint holds at every sample. Joint velocities are the IK's derivative along
-/// the path times the bell speed; `duration` is stretched when one would exceed its limit.
+/// the path times the bell speed. Each piece takes its share of `duration` by length,
+/// stretched until its joints keep [`LIMIT_FRACTION`] of their velocity and acceleration
+/// limits.
 ///
 /// # Errors
-/// [`RrtError::Timing`] for a non-positive rate or duration; [`RrtError::Tracking`] when the
-/// IK cannot follow the path between its checked points.
+/// [`RrtError::Timing`] for a non-positive rate or duration, or a piece whose timing does not
+/// settle within the limits; [`RrtError::Tracking`] when the IK cannot follow the path between
+/// its checked points.
 pub fn time_constrained(
     robot: &Robot,
+    limits: &Limits,
     chart: &Chart,
     path: &ConstrainedPath,
     duration: Real,
@@ -846,68 +880,103 @@ pub fn time_constrained(
     let pieces = pieces(robot, chart, path)?;
     let lengths: Vec<Real> = pieces.iter().map(|p| p.length(chart)).collect();
     let length: Real = lengths.iter().sum();
-    // Which piece length s falls in, and how far into it.
-    let locate = |s: Real| -> Option<(usize, Real)> {
-        let mut rest = s.clamp(0.0, length);
-        for (i, l) in lengths.iter().enumerate() {
-            if rest <= *l && *l > 0.0 {
-                return Some((i, rest));
-            }
-            rest -= l;
-        }
-        None
+    let within = Limits {
+        velocity: limits.velocity * LIMIT_FRACTION,
+        acceleration: limits.acceleration * LIMIT_FRACTION,
+        ..*limits
     };
-    let speed = robot.velocity_limits();
-    let mut duration = duration;
+    let first = path.configurations[0];
+    let (mut times, mut positions, mut velocities) =
+        (vec![0.0], vec![first], vec![JointVector::zeros()]);
     let mut stretched = false;
-    // Positions depend on the timing only through where the samples fall, so a few rounds of
-    // stretching settle the duration.
-    for _ in 0..4 {
-        let bell = BellProfile::new(duration, length)
-            .map_err(|e| trajectory_error(TrajectoryError::Join(e)))?;
-        let times = sample_times(0.0, duration, rate);
-        let mut positions = Vec::with_capacity(times.len());
-        let mut velocities = Vec::with_capacity(times.len());
-        let mut q = path.configurations[0];
-        for &t in &times {
-            let s = bell.progress(t);
-            let lost = || RrtError::Tracking { at: s };
-            let (q_next, rate_of_change) = match locate(s) {
-                None => (*path.configurations.last().unwrap_or(&q), JointVector::zeros()),
-                Some((i, into)) => match &pieces[i] {
-                    Piece::SelfMotion { a, b } => {
-                        let u = (b - a) / lengths[i];
-                        (a + u * into, u)
-                    }
-                    Piece::Edge(edge) => {
-                        let Edge { a, b, track } = edge.as_ref();
-                        let tau = into / lengths[i];
-                        let at = |t: Real| on_track(robot, chart, (a, b), track, t);
-                        let q = at(tau).ok_or_else(lost)?;
-                        // dq/ds by a central difference on the same branch.
-                        let h = 1e-6;
-                        let (lo, hi) = ((tau - h).max(0.0), (tau + h).min(1.0));
-                        let ahead = at(hi).ok_or_else(lost)?;
-                        let behind = at(lo).ok_or_else(lost)?;
-                        (q, (ahead - behind) / ((hi - lo) * lengths[i]))
-                    }
-                },
-            };
-            q = q_next;
-            positions.push(q);
-            velocities.push(rate_of_change * bell.speed(t));
+    let mut travelled = 0.0;
+    for (piece, &piece_length) in pieces.iter().zip(&lengths) {
+        if piece_length <= 0.0 {
+            continue;
         }
-        let ratio = velocities
-            .iter()
-            .flat_map(|v| (0..v.len()).map(move |i| v[i].abs() / speed[i]))
-            .fold(0.0, Real::max);
-        if ratio <= 1.0 {
+        let mut piece_duration = duration * piece_length / length;
+        let mut timed = None;
+        for _ in 0..8 {
+            let samples = time_piece(robot, chart, piece, piece_length, piece_duration, rate)
+                .map_err(|e| match e {
+                    RrtError::Tracking { at } => RrtError::Tracking { at: travelled + at },
+                    e => e,
+                })?;
             let trajectory =
-                Trajectory::new(times, positions, velocities).map_err(trajectory_error)?;
-            return Ok(TimedPath { trajectory, duration, stretched });
+                Trajectory::new(samples.0, samples.1, samples.2).map_err(trajectory_error)?;
+            let stretch = peaks(&trajectory, 0.0, piece_duration).stretch(&within);
+            if stretch <= 1.0 {
+                timed = Some(trajectory);
+                break;
+            }
+            piece_duration *= stretch * 1.01;
+            stretched = true;
         }
-        duration *= ratio * 1.01;
-        stretched = true;
+        let trajectory = timed.ok_or_else(|| RrtError::Timing {
+            reason: "a piece's duration does not settle under the joint limits".into(),
+        })?;
+        let offset = *times.last().unwrap_or(&0.0);
+        // The piece's first sample is where the last one ended, at rest.
+        for ((t, q), qd) in trajectory
+            .times()
+            .iter()
+            .zip(trajectory.positions())
+            .zip(trajectory.velocities())
+            .skip(1)
+        {
+            times.push(offset + t);
+            positions.push(*q);
+            velocities.push(*qd);
+        }
+        travelled += piece_length;
     }
-    Err(RrtError::Timing { reason: "the duration does not settle under the speed limits".into() })
+    let total = *times.last().unwrap_or(&0.0);
+    let trajectory = Trajectory::new(times, positions, velocities).map_err(trajectory_error)?;
+    Ok(TimedPath {
+        trajectory,
+        duration: total,
+        stretched: stretched || total > duration * (1.0 + 1e-9),
+    })
+}
+
+/// One piece timed by a rest-to-rest bell of `duration` over its `length`: times from 0, q,
+/// q'.
+fn time_piece(
+    robot: &Robot,
+    chart: &Chart,
+    piece: &Piece,
+    length: Real,
+    duration: Real,
+    rate: Real,
+) -> Result<(Vec<Real>, Vec<JointVector>, Vec<JointVector>), RrtError> {
+    let bell = BellProfile::new(duration, length)
+        .map_err(|e| RrtError::Timing { reason: TrajectoryError::Join(e).to_string() })?;
+    let times = sample_times(0.0, duration, rate);
+    let mut positions = Vec::with_capacity(times.len());
+    let mut velocities = Vec::with_capacity(times.len());
+    for &t in &times {
+        let s = bell.progress(t);
+        let lost = || RrtError::Tracking { at: s };
+        let (q, rate_of_change) = match piece {
+            Piece::SelfMotion { a, b } => {
+                let u = (b - a) / length;
+                (a + u * s, u)
+            }
+            Piece::Edge(edge) => {
+                let Edge { a, b, track } = edge.as_ref();
+                let tau = (s / length).clamp(0.0, 1.0);
+                let at = |t: Real| on_track(robot, chart, (a, b), track, t);
+                let q = at(tau).ok_or_else(lost)?;
+                // dq/ds by a central difference on the same branch.
+                let h = 1e-6;
+                let (lo, hi) = ((tau - h).max(0.0), (tau + h).min(1.0));
+                let ahead = at(hi).ok_or_else(lost)?;
+                let behind = at(lo).ok_or_else(lost)?;
+                (q, (ahead - behind) / ((hi - lo) * length))
+            }
+        };
+        positions.push(q);
+        velocities.push(rate_of_change * bell.speed(t));
+    }
+    Ok((times, positions, velocities))
 }

@@ -7,6 +7,8 @@
 //! [`hamp::plan_handover`] plans a handover the HAMP way (METHODS.md §3.4);
 //! the baselines [`gpm`], [`clik`] and [`pmp`], each a resolver of the velocity loop in
 //! [`control`].
+//! Their long loops report progress and check the user's wall-clock limit through a
+//! [`monitor::Monitor`]; without a limit, results never depend on the clock.
 
 pub mod clik;
 pub mod compare;
@@ -15,11 +17,13 @@ pub mod control;
 pub mod gpm;
 pub mod hamp;
 pub mod map;
+pub mod monitor;
 pub(crate) mod plan;
 pub mod pmp;
 pub mod qp;
 mod report;
 pub mod rrt;
 
+pub use monitor::Monitor;
 pub use plan::{PlanOptions, Progress, SolveError, plan, plan_with_progress};
 pub use report::{Fallback, Plan, QpStats, SegmentReport, Tolerance, VariableError};

@@ -1,24 +1,37 @@
 //! A whole task: decompose, solve every segment from where the last one really ended, join
 //! segments (+Tr within an action, +Se between actions) and report on each.
+//!
+//! The joint limits (position, velocity, acceleration) are an invariant of the output: a
+//! segment that exceeds a rate limit on its own is slowed down as a whole (it starts and ends
+//! at rest, so its neighbours do not change); a +Tr blend that exceeds one is shortened, down
+//! to switching at rest; and the output at its rate is checked again at every instant of its
+//! Hermite curve, slowing the segments it still finds too fast. What cannot be repaired (a
+//! position limit) is a warning naming the segment, whose report is then not ok.
 
-use super::constrained_rrt::{Chart, constrained_rrt, time_constrained};
-use super::map::{MapError, MapOptions, map_segment};
+use std::time::Instant;
+
+use super::constrained_rrt::{Chart, constrained_rrt_monitored, time_constrained};
 use super::control::{BaselineOptions, ControlError, ControlOptions, ControlRun};
+use super::map::{MapError, MapOptions, map_segment};
+use super::monitor::{Monitor, deadline_after};
 use super::qp::{self, Component, QpError, QpOptions, SegmentProblem};
 use super::report::{Fallback, Plan, QpStats, SegmentReport, VariableError};
-use super::rrt::{RrtError, RrtOptions, RrtStats, TimedPath, rrt_connect, time_parameterise};
+use super::rrt::{
+    RrtError, RrtOptions, RrtStats, TimedPath, rrt_connect_monitored, time_parameterise,
+};
 use super::{clik, gpm, pmp};
 use crate::collision::CollisionScene;
 use crate::decompose::{
     ArmState, DecomposeError, DecomposeOptions, PlannedAction, PlannedSegment, SegmentPattern,
     decompose, goal_error,
 };
-use crate::kinematics::{HatState, hat_to_cpsa, ik_cpsa};
+use crate::kinematics::{HatState, arm_pose, hat_to_cpsa, ik_cpsa};
 use crate::language::{ActionBody, PrimitiveConstraint, SolverChoice, Space, Task, Variable};
 use crate::math::{DOF, JointVector, Real, Vector3};
+use crate::metrics::smoothness::{normalised_jerk, speed_peaks};
 use crate::profile::{BodyFrames, ProfileError, Reference, Role, Sample};
 use crate::robot::Robot;
-use crate::trajectory::{self, Trajectory, TrajectoryError};
+use crate::trajectory::{self, Limits, Trajectory, TrajectoryError, peaks};
 
 /// Settings of [`plan`].
 #[derive(Debug, Clone, Default)]
@@ -37,17 +50,38 @@ pub struct PlanOptions {
     pub solver: Option<SolverChoice>,
     /// Output rate (Hz), overriding the task's `settings { rate }`.
     pub rate: Option<Real>,
+    /// The acceleration limits as a multiple of the robot's, overriding the task's
+    /// `settings { acceleration }`.
+    pub acceleration_scale: Option<Real>,
+    /// Wall-clock limit of the whole plan (s), default none. Checked inside every solver loop;
+    /// when it passes the plan fails with a `timeout`. Without it the outcome never depends
+    /// on the machine's speed.
+    pub time_limit: Option<Real>,
 }
 
-/// How far planning has got, for progress displays.
+/// How far planning has got, for progress displays: `done` whole segments, then `fraction`
+/// of the next, so (done + fraction) / total grows from 0 to 1. Reported when a segment
+/// starts and ends and from inside the solvers' loops (the QP's share of its reference time,
+/// an RRT's share of its sample budget).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Progress {
     /// Segments solved so far.
     pub done: usize,
     /// Segments in the task.
     pub total: usize,
-    /// The action being solved.
+    /// The action being solved (or the last one solved, once `done == total`).
     pub action: String,
+    /// The segment being solved within its action (0-based).
+    pub segment: usize,
+    /// The share of that segment done, in [0, 1].
+    pub fraction: Real,
+}
+
+impl Progress {
+    /// The share of the whole plan done, in [0, 1].
+    pub fn overall(&self) -> Real {
+        if self.total == 0 { 1.0 } else { (self.done as Real + self.fraction) / self.total as Real }
+    }
 }
 
 /// Why a task cannot be planned.
@@ -71,6 +105,12 @@ pub enum SolveError {
     InvalidRate {
         /// The rate asked for (Hz).
         rate: Real,
+    },
+    /// The acceleration scale is not positive and finite.
+    #[error("invalid acceleration scale {scale}: it must be positive and finite")]
+    InvalidAccelerationScale {
+        /// The scale asked for.
+        scale: Real,
     },
     /// The solver asked for does not exist yet for this kind of segment.
     #[error(
@@ -155,7 +195,8 @@ pub fn plan(robot: &Robot, task: &Task, options: &PlanOptions) -> Result<Plan, S
     plan_with_progress(robot, task, options, &mut |_| {})
 }
 
-/// [`plan`], calling `progress` after each segment is solved.
+/// [`plan`], calling `progress` when each segment starts and ends and from inside the
+/// solvers' loops (see [`Progress`]).
 ///
 /// # Errors
 /// As [`plan`].
@@ -172,6 +213,11 @@ pub fn plan_with_progress(
     if !task.scene.is_empty() && !robot.has_arm_geometry() {
         return Err(SolveError::NoArmGeometry { warnings: robot.geometry_warnings.clone() });
     }
+    let scale = options.acceleration_scale.unwrap_or(task.settings.acceleration);
+    if !(scale.is_finite() && scale > 0.0) {
+        return Err(SolveError::InvalidAccelerationScale { scale });
+    }
+    let deadline = options.time_limit.and_then(deadline_after);
     let decomposition = decompose(robot, task, &options.decompose)?;
     let task_b = task.in_base_frame(&robot.structure.shoulder_in_base_link);
     let total = decomposition.actions.iter().map(|a| a.segments.len()).sum();
@@ -179,39 +225,78 @@ pub fn plan_with_progress(
         robot,
         task: &task_b,
         options,
+        qp: QpOptions { acceleration_scale: scale, ..options.qp },
+        limits: Limits::of(robot).with_acceleration_scale(scale),
+        deadline,
         rate,
         q: decomposition.start,
-        whole: None,
-        segments: Vec::with_capacity(total),
-        wrist_reference: Vec::new(),
+        pieces: Vec::with_capacity(total),
         notes: Vec::new(),
     };
     for action in &decomposition.actions {
-        state.action(action, &mut |done| {
-            progress(&Progress { done, total, action: action.name.clone() })
-        })?;
+        state.action(action, total, progress)?;
     }
-    let whole = match state.whole {
-        Some(w) => w.resample(rate)?,
+    let (whole, mut notes) = if state.pieces.is_empty() {
         // No action: the arm stays at the start.
-        None => Trajectory::new(vec![0.0], vec![decomposition.start], vec![JointVector::zeros()])?,
+        let still = vec![JointVector::zeros()];
+        (Trajectory::new(vec![0.0], vec![decomposition.start], still)?, Vec::new())
+    } else {
+        state.finish()?
     };
     let mut warnings = state.notes;
+    warnings.append(&mut notes);
     if !task.scene.is_empty() {
         warnings.extend(robot.geometry_warnings.iter().map(|w| format!("collision geometry: {w}")));
     }
-    warnings.extend(state.segments.iter().filter(|s| !s.reached).map(missed));
-    warnings.extend(state.segments.iter().filter(|s| !s.path_kept).map(left_path));
+    let mut segments = Vec::with_capacity(state.pieces.len());
+    let mut wrist_reference = Vec::new();
+    for piece in state.pieces {
+        wrist_reference.extend(piece.reference.iter().map(|(t, p)| (piece.start + t, *p)));
+        segments.push(piece.report);
+    }
+    warnings.extend(segments.iter().filter(|s| !s.reached).map(missed));
+    warnings.extend(segments.iter().filter(|s| !s.path_kept).map(left_path));
+    warnings.extend(segments.iter().filter(|s| !s.limits_kept).map(over_limits));
     Ok(Plan {
         task: decomposition.task,
         joint_names: robot.joint_names().iter().map(|n| (*n).to_owned()).collect(),
         rate,
         trajectory: whole,
-        segments: state.segments,
-        wrist_reference: state.wrist_reference,
+        segments,
+        wrist_reference,
         safety_distance: options.qp.safety_distance,
         warnings,
     })
+}
+
+/// Rounds of slowing the segments that the output at its rate still finds too fast.
+const OUTPUT_ROUNDS: usize = 8;
+/// Relative tolerance of the limit checks: rounding, not motion.
+const LIMIT_TOLERANCE: Real = 1e-9;
+
+/// One solved segment waiting to be joined: its motion from time 0 (at the solver's rate), its
+/// report, and what joining decides.
+struct Piece {
+    /// The action's index in the decomposition.
+    action: usize,
+    trajectory: Trajectory,
+    report: SegmentReport,
+    /// The reference wrist path, in the segment's own time.
+    reference: Vec<(Real, Vector3)>,
+    /// The factor the segment is slowed down by (1: as solved).
+    stretch: Real,
+    /// Start in the plan's time (s), once joined.
+    start: Real,
+}
+
+impl Piece {
+    fn timed(&self) -> Trajectory {
+        if self.stretch > 1.0 {
+            self.trajectory.stretched(self.stretch)
+        } else {
+            self.trajectory.clone()
+        }
+    }
 }
 
 /// The planning state between actions.
@@ -219,12 +304,16 @@ struct Solver<'a> {
     robot: &'a Robot,
     task: &'a Task,
     options: &'a PlanOptions,
+    /// The QP's options with the plan's acceleration scale.
+    qp: QpOptions,
+    /// The limits every output holds.
+    limits: Limits,
+    /// When the user's time limit passes, if there is one.
+    deadline: Option<Instant>,
     rate: Real,
     /// Where the arm really is: the end of what has been solved.
     q: JointVector,
-    whole: Option<Trajectory>,
-    segments: Vec<SegmentReport>,
-    wrist_reference: Vec<(Real, Vector3)>,
+    pieces: Vec<Piece>,
     /// Warnings other than missed goals: fallbacks and stretched durations.
     notes: Vec<String>,
 }
@@ -255,21 +344,19 @@ impl Job<'_> {
 }
 
 impl Solver<'_> {
-    /// Solves and joins the action's segments, calling `solved` with the number of segments
-    /// solved in the whole plan after each.
+    /// Solves the action's segments one after the other, each from where the last ended,
+    /// reporting progress.
     fn action(
         &mut self,
         action: &PlannedAction,
-        solved: &mut dyn FnMut(usize),
+        total: usize,
+        progress: &mut dyn FnMut(&Progress),
     ) -> Result<(), SolveError> {
         let scene = CollisionScene::new(&self.task.action_scene(action.index));
         let hard = matches!(
             &self.task.actions[action.index].body,
             ActionBody::Constraints { path: Some(path), .. } if path.hard
         );
-        let action_start = self.whole.as_ref().map_or(0.0, Trajectory::end);
-        let mut joined: Option<Trajectory> = None;
-        let mut last: Option<(Real, Real)> = None; // (start, duration) of the previous segment
         for (k, segment) in action.segments.iter().enumerate() {
             let problem = segment_problem(self.robot, &self.q, action, k, segment)?;
             let chart = Chart::new(self.robot, &problem);
@@ -288,33 +375,168 @@ impl Solver<'_> {
                 chart,
                 hard: hard && carries_path,
             };
-            let solution = self.solve(&job)?;
-            let duration = solution.trajectory.duration();
-            let (start, next) = match (joined.take(), last) {
-                (Some(before), Some((prev_start, prev_duration))) => {
-                    let overlap = self.task.settings.transition * prev_duration.min(duration);
-                    let start = prev_start + prev_duration - overlap;
-                    (start, trajectory::join_transitional(&before, &solution.trajectory, overlap)?)
-                }
-                _ => (action_start, shifted(&solution.trajectory, action_start)?),
+            let done = self.pieces.len();
+            let name = action.name.clone();
+            // Never backwards, when `auto` goes on from one solver to another.
+            let mut most: Real = 0.0;
+            let mut report = |fraction: Real| {
+                most = most.max(fraction);
+                let fraction = most;
+                progress(&Progress { done, total, action: name.clone(), segment: k, fraction })
             };
-            joined = Some(next);
-            last = Some((start, duration));
+            report(0.0);
+            let solution = self.solve(&job, &mut Monitor::new(self.deadline, &mut report))?;
             if let Some(end) = solution.trajectory.positions().last() {
                 self.q = *end;
             }
-            self.reference(&job.problem, start);
-            let report = self.report(&job, &solution, start);
-            self.segments.push(report);
-            solved(self.segments.len());
-        }
-        if let Some(action_trajectory) = joined {
-            self.whole = Some(match self.whole.take() {
-                Some(before) => trajectory::join_sequential(&before, &action_trajectory)?,
-                None => action_trajectory,
+            let reference = self.reference(&job.problem);
+            let report = self.report(&job, &solution);
+            self.pieces.push(Piece {
+                action: action.index,
+                trajectory: solution.trajectory,
+                report,
+                reference,
+                stretch: 1.0,
+                start: 0.0,
+            });
+            let done = self.pieces.len();
+            progress(&Progress {
+                done,
+                total,
+                action: action.name.clone(),
+                segment: k,
+                fraction: 0.0,
             });
         }
         Ok(())
+    }
+
+    /// Joins the solved segments into the output at its rate, keeping the limits: each
+    /// segment slowed as a whole where it exceeds a rate limit, each +Tr blend shortened where
+    /// it does, and the output checked again at every instant until it holds the limits (or
+    /// the rounds run out). Completes the reports with the measures of the output. Returns
+    /// the output and the notes on what was repaired.
+    fn finish(&mut self) -> Result<(Trajectory, Vec<String>), SolveError> {
+        for piece in &mut self.pieces {
+            let t = &piece.trajectory;
+            let stretch = peaks(t, t.start(), t.end()).stretch(&self.limits);
+            if stretch > 1.0 + LIMIT_TOLERANCE {
+                piece.stretch = stretch * (1.0 + 1e-6);
+            }
+        }
+        let mut round = 0;
+        let (output, blend_notes) = loop {
+            let (whole, notes) = self.join_all()?;
+            let output = whole.resample(self.rate)?;
+            round += 1;
+            let mut again = false;
+            for piece in &mut self.pieces {
+                let end = piece.start + piece.trajectory.duration() * piece.stretch;
+                let stretch = peaks(&output, piece.start, end).stretch(&self.limits);
+                if stretch > 1.0 + LIMIT_TOLERANCE && round < OUTPUT_ROUNDS {
+                    // A little more than asked: the output's samples fall elsewhere on the
+                    // slower motion, and its curve between them with them.
+                    piece.stretch *= stretch * 1.02;
+                    again = true;
+                }
+            }
+            if !again {
+                break (output, notes);
+            }
+        };
+        let mut notes = blend_notes;
+        for piece in &mut self.pieces {
+            if piece.stretch > 1.0 {
+                let r = &piece.report;
+                let solved = piece.trajectory.duration();
+                notes.push(format!(
+                    "action `{}`, segment {}: slowed down {:.3} times ({:.2} s instead of {:.2} s) \
+                     to keep every joint within its velocity and acceleration limits",
+                    r.action,
+                    r.segment + 1,
+                    piece.stretch,
+                    solved * piece.stretch,
+                    solved
+                ));
+            }
+            complete(piece, &output, self.robot, &self.limits);
+        }
+        Ok((output, notes))
+    }
+
+    /// Every segment joined at its current stretch: +Tr within an action (each blend
+    /// shortened where it would exceed a limit), +Se between actions. Sets each piece's start;
+    /// returns the trajectory and a note per shortened blend.
+    fn join_all(&mut self) -> Result<(Trajectory, Vec<String>), SolveError> {
+        let mut notes = Vec::new();
+        let mut whole: Option<Trajectory> = None;
+        let mut i = 0;
+        while i < self.pieces.len() {
+            let action = self.pieces[i].action;
+            let action_start = whole.as_ref().map_or(0.0, Trajectory::end);
+            let mut joined: Option<Trajectory> = None;
+            let mut last: Option<(Real, Real)> = None; // (start, duration) of the previous segment
+            while i < self.pieces.len() && self.pieces[i].action == action {
+                let segment = self.pieces[i].timed();
+                let duration = segment.duration();
+                let (start, next) = match (joined.take(), last) {
+                    (Some(before), Some((prev_start, prev_duration))) => {
+                        let overlap = self.task.settings.transition * prev_duration.min(duration);
+                        let (next, used) = self.blend(&before, &segment, overlap)?;
+                        if used < overlap {
+                            let r = &self.pieces[i].report;
+                            notes.push(format!(
+                                "action `{}`, segment {}: the +Tr blend into it overlaps {:.3} s \
+                                 instead of {:.3} s to keep the joint limits",
+                                r.action,
+                                r.segment + 1,
+                                used,
+                                overlap
+                            ));
+                        }
+                        (prev_start + prev_duration - used, next)
+                    }
+                    _ => (action_start, shifted(&segment, action_start)?),
+                };
+                joined = Some(next);
+                last = Some((start, duration));
+                self.pieces[i].start = start;
+                i += 1;
+            }
+            if let Some(action_trajectory) = joined {
+                whole = Some(match whole.take() {
+                    Some(before) => trajectory::join_sequential(&before, &action_trajectory)?,
+                    None => action_trajectory,
+                });
+            }
+        }
+        let whole = whole.ok_or(TrajectoryError::Empty)?;
+        Ok((whole, notes))
+    }
+
+    /// The +Tr blend of `before` (ending with a segment at rest) into `next` (starting at rest
+    /// where it ends) over `overlap` (appendix A) when it keeps the limits over the overlap;
+    /// else over half, a quarter of it, and at last none (a switch at rest, which keeps them
+    /// whenever both sides do). Returns the joined trajectory and the overlap used.
+    fn blend(
+        &self,
+        before: &Trajectory,
+        next: &Trajectory,
+        overlap: Real,
+    ) -> Result<(Trajectory, Real), SolveError> {
+        for used in [overlap, 0.5 * overlap, 0.25 * overlap] {
+            if used <= 0.0 {
+                break;
+            }
+            let joined = trajectory::join_transitional(before, next, used)?;
+            let window = peaks(&joined, before.end() - used, before.end());
+            if window.stretch(&self.limits) <= 1.0 + LIMIT_TOLERANCE
+                && window.positions_within(&self.limits, LIMIT_TOLERANCE)
+            {
+                return Ok((joined, used));
+            }
+        }
+        Ok((trajectory::join_transitional(before, next, 0.0)?, 0.0))
     }
 
     /// Solves one segment with its solver: the override, else its own choice. `rrt` plans a
@@ -324,26 +546,26 @@ impl Solver<'_> {
     /// mixed segment (pattern 3) to the QP and, when the QP stalls, misses the goal or leaves
     /// a hard path, to the constrained RRT, keeping the QP's closest result with a warning
     /// when that fails too; and every other segment to the QP.
-    fn solve(&mut self, job: &Job) -> Result<Solved, SolveError> {
+    fn solve(&mut self, job: &Job, monitor: &mut Monitor) -> Result<Solved, SolveError> {
         let pattern = job.segment.pattern;
         let kept = |this: &mut Self, source: RrtError, why: &str| {
             let name = job.name();
             this.notes.push(format!("{name}: {why}; rrt: {source}; the QP's result is kept"));
         };
         match self.options.solver.unwrap_or(job.segment.solver) {
-            SolverChoice::Qp => self.qp(job),
+            SolverChoice::Qp => self.qp(job, monitor),
             SolverChoice::Auto if pattern == SegmentPattern::Goal && !job.scene.is_empty() => {
-                match self.rrt(job) {
+                match self.rrt(job, monitor) {
                     Ok(solved) => Ok(solved),
                     Err(SolveError::Rrt { source, .. }) => {
                         kept(self, source, "a goal segment among obstacles");
-                        self.qp(job)
+                        self.qp(job, monitor)
                     }
                     Err(e) => Err(e),
                 }
             }
             SolverChoice::Auto if pattern == SegmentPattern::Mixed => {
-                let qp = self.qp(job)?;
+                let qp = self.qp(job, monitor)?;
                 let why = match (qp.reached, qp.path_kept, qp.stalled) {
                     (true, true, _) => return Ok(qp),
                     (_, false, _) => Fallback::QpLeftPath,
@@ -359,7 +581,7 @@ impl Solver<'_> {
                         Err(e) => return Err(e),
                     }
                 }
-                match self.constrained(job) {
+                match self.constrained(job, monitor) {
                     Ok(rrt) if rrt.reached && rrt.path_kept => {
                         Ok(Solved { fallback: Some(why), ..rrt })
                     }
@@ -378,9 +600,9 @@ impl Solver<'_> {
                     Err(e) => Err(e),
                 }
             }
-            SolverChoice::Auto => self.qp(job),
-            SolverChoice::Rrt if pattern == SegmentPattern::Goal => self.rrt(job),
-            SolverChoice::Rrt => self.constrained(job),
+            SolverChoice::Auto => self.qp(job, monitor),
+            SolverChoice::Rrt if pattern == SegmentPattern::Goal => self.rrt(job, monitor),
+            SolverChoice::Rrt => self.constrained(job, monitor),
             SolverChoice::Map => self.map(job),
             SolverChoice::Gpm => self.baseline(job, SolverChoice::Gpm, |r, p, q, o, c| {
                 gpm::solve_segment(r, p, q, &o.gpm, c)
@@ -394,14 +616,20 @@ impl Solver<'_> {
         }
     }
 
-    fn qp(&self, job: &Job) -> Result<Solved, SolveError> {
-        let solution =
-            qp::solve_segment(self.robot, job.scene, &job.problem, &self.q, &self.options.qp)
-                .map_err(|source| SolveError::Qp {
-                    action: job.action.name.clone(),
-                    segment: job.k,
-                    source,
-                })?;
+    fn qp(&self, job: &Job, monitor: &mut Monitor) -> Result<Solved, SolveError> {
+        let solution = qp::solve_segment_monitored(
+            self.robot,
+            job.scene,
+            &job.problem,
+            &self.q,
+            &self.qp,
+            monitor,
+        )
+        .map_err(|source| SolveError::Qp {
+            action: job.action.name.clone(),
+            segment: job.k,
+            source,
+        })?;
         let (path_errors, path_kept) = self.assess(job, &solution.trajectory);
         Ok(Solved {
             solver: SolverChoice::Qp,
@@ -420,7 +648,7 @@ impl Solver<'_> {
 
     /// A goal segment by RRT-Connect in joint space towards the IK branches of its end state
     /// (the decomposition's configuration first), timed with the bell profile.
-    fn rrt(&mut self, job: &Job) -> Result<Solved, SolveError> {
+    fn rrt(&mut self, job: &Job, monitor: &mut Monitor) -> Result<Solved, SolveError> {
         let end = job.segment.end;
         let mut goals = vec![end];
         if let Ok(state) = ArmState::at(self.robot, &end) {
@@ -428,21 +656,25 @@ impl Solver<'_> {
                 goals.extend(branches.into_iter().filter(|q| (q - end).amax() > 1e-9));
             }
         }
-        let path = rrt_connect(self.robot, job.scene, &self.q, &goals, &self.rrt_options())
+        let options = self.rrt_options();
+        let path = rrt_connect_monitored(self.robot, job.scene, &self.q, &goals, &options, monitor)
             .map_err(|e| job.rrt_failed(e))?;
         let rate = 1.0 / self.options.qp.step;
-        let timed = time_parameterise(self.robot, &path.waypoints, job.segment.duration, rate)?;
+        let timed = time_parameterise(&self.limits, &path.waypoints, job.segment.duration, rate)?;
         Ok(self.timed(job, timed, path.stats))
     }
 
     /// A segment with a path by RRT-Connect in its constrained space, timed with the bell
     /// profile along the chart path.
-    fn constrained(&mut self, job: &Job) -> Result<Solved, SolveError> {
+    fn constrained(&mut self, job: &Job, monitor: &mut Monitor) -> Result<Solved, SolveError> {
         let options = self.rrt_options();
-        let path = constrained_rrt(self.robot, job.scene, &job.chart, &self.q, &options)
-            .map_err(|e| job.rrt_failed(e))?;
+        let path = constrained_rrt_monitored(
+            self.robot, job.scene, &job.chart, &self.q, &options, monitor,
+        )
+        .map_err(|e| job.rrt_failed(e))?;
         let rate = 1.0 / self.options.qp.step;
-        let timed = time_constrained(self.robot, &job.chart, &path, job.segment.duration, rate)
+        let (chart, duration) = (&job.chart, job.segment.duration);
+        let timed = time_constrained(self.robot, &self.limits, chart, &path, duration, rate)
             .map_err(|e| job.rrt_failed(e))?;
         Ok(self.timed(job, timed, path.stats))
     }
@@ -536,7 +768,7 @@ impl Solver<'_> {
         if timed.stretched {
             self.notes.push(format!(
                 "{}: the rrt path takes {:.2} s instead of {:.2} s to keep every joint within \
-                 its speed limit",
+                 its velocity and acceleration limits",
                 job.name(),
                 timed.duration,
                 job.segment.duration
@@ -581,16 +813,17 @@ impl Solver<'_> {
         (worst, within || !job.hard)
     }
 
-    /// Appends the segment's reference Pw at the output rate, in plan time.
-    fn reference(&mut self, problem: &SegmentProblem, start: Real) {
-        for t in trajectory::sample_times(0.0, problem.duration, self.rate) {
-            if let Some(p) = reference_wrist(self.robot, problem, t) {
-                self.wrist_reference.push((start + t, p));
-            }
-        }
+    /// The segment's reference Pw at the output rate, in its own time.
+    fn reference(&self, problem: &SegmentProblem) -> Vec<(Real, Vector3)> {
+        trajectory::sample_times(0.0, problem.duration, self.rate)
+            .into_iter()
+            .filter_map(|t| reference_wrist(self.robot, problem, t).map(|p| (t, p)))
+            .collect()
     }
 
-    fn report(&self, job: &Job, solution: &Solved, start: Real) -> SegmentReport {
+    /// The segment's report as solved, in its own time; [`complete`] adds what joining
+    /// decides and the measures of the output.
+    fn report(&self, job: &Job, solution: &Solved) -> SegmentReport {
         let tolerance = &self.options.qp.tolerance;
         let error = |variable: Variable, error: Real| VariableError {
             variable,
@@ -614,8 +847,8 @@ impl Solver<'_> {
             pattern: segment.pattern,
             solver: solution.solver,
             focus: segment.primitives.first().map(|p| p.variables.clone()).unwrap_or_default(),
-            start,
-            end: start + solution.trajectory.duration(),
+            start: 0.0,
+            end: solution.trajectory.duration(),
             duration: segment.duration,
             settle: solution.settle,
             errors: errors.collect(),
@@ -629,6 +862,13 @@ impl Solver<'_> {
             qp: solution.qp,
             rrt: solution.rrt,
             fallback: solution.fallback,
+            peak_velocity_ratio: 0.0,
+            peak_acceleration_ratio: 0.0,
+            limits_kept: true,
+            slowed_down: 1.0,
+            joint_jerk: 0.0,
+            wrist_jerk: 0.0,
+            speed_peaks: featured_peaks(self.robot, &segment_focus(job), &solution.trajectory),
         }
     }
 }
@@ -694,6 +934,68 @@ fn map_fits(job: &Job) -> bool {
             .components
             .iter()
             .all(|c| c.variable == Variable::Swivel || c.role == Role::Path)
+
+/// The segment's featured variable: the first of its focus, else the wrist position.
+fn segment_focus(job: &Job) -> Variable {
+    job.segment
+        .primitives
+        .first()
+        .and_then(|p| p.variables.first().copied())
+        .unwrap_or(Variable::Pw)
+}
+
+/// The number of peaks of `variable`'s speed over the trajectory's samples (the change of its
+/// value between samples, over their interval).
+fn featured_peaks(robot: &Robot, variable: &Variable, trajectory: &Trajectory) -> usize {
+    let states: Vec<Option<ArmState>> =
+        trajectory.positions().iter().map(|q| ArmState::at(robot, q).ok()).collect();
+    let times = trajectory.times();
+    let speeds: Vec<Real> = (1..states.len())
+        .map(|k| match (&states[k - 1], &states[k]) {
+            (Some(a), Some(b)) => {
+                goal_error(b, &[(*variable, a.value(*variable))]) / (times[k] - times[k - 1])
+            }
+            _ => 0.0,
+        })
+        .collect();
+    speed_peaks(&speeds)
+}
+
+/// Completes a segment's report with where joining put it and the measures of the output
+/// over its time: peak rate ratios, whether the limits hold, the normalised jerks.
+fn complete(piece: &mut Piece, output: &Trajectory, robot: &Robot, limits: &Limits) {
+    let (start, stretch, solved) = (piece.start, piece.stretch, piece.trajectory.duration());
+    let report = &mut piece.report;
+    report.start = start;
+    report.end = start + solved * stretch;
+    report.settle *= stretch;
+    report.slowed_down = stretch;
+    if let Some(c) = report.clearance.as_mut() {
+        c.time = start + c.time * stretch;
+    }
+    let window = peaks(output, report.start, report.end);
+    report.peak_velocity_ratio = window.velocity_ratio(limits);
+    report.peak_acceleration_ratio = window.acceleration_ratio(limits);
+    report.limits_kept = window.stretch(limits) <= 1.0 + LIMIT_TOLERANCE
+        && window.positions_within(limits, LIMIT_TOLERANCE);
+    let inside: Vec<usize> = (0..output.len())
+        .filter(|&k| {
+            output.times()[k] >= report.start - 1e-12 && output.times()[k] <= report.end + 1e-12
+        })
+        .collect();
+    let times: Vec<Real> = inside.iter().map(|&k| output.times()[k]).collect();
+    let joint_velocities: Vec<JointVector> =
+        inside.iter().map(|&k| output.velocities()[k]).collect();
+    report.joint_jerk = normalised_jerk(&times, &joint_velocities);
+    let wrist: Vec<Vector3> =
+        inside.iter().map(|&k| arm_pose(robot, &output.positions()[k]).wrist).collect();
+    let wrist_velocities: Vec<Vector3> = (0..wrist.len())
+        .map(|k| {
+            let (a, b) = (k.saturating_sub(1), (k + 1).min(wrist.len() - 1));
+            if b > a { (wrist[b] - wrist[a]) / (times[b] - times[a]) } else { Vector3::zeros() }
+        })
+        .collect();
+    report.wrist_jerk = normalised_jerk(&times, &wrist_velocities);
 }
 
 /// A segment as one of the solvers solved it.
@@ -775,6 +1077,18 @@ fn describe(e: &VariableError) -> String {
         Variable::Pw => format!("Pw by {:.1} mm", e.error * 1e3),
         v => format!("{} by {:.2}°", v.symbol(), e.error.to_degrees()),
     }
+}
+
+/// The warning for a segment whose output exceeds a joint limit.
+fn over_limits(s: &SegmentReport) -> String {
+    format!(
+        "action `{}`, segment {}: exceeds the joint limits (peak |q'|/limit {:.3}, |q''|/limit \
+         {:.3}, or a position limit)",
+        s.action,
+        s.segment + 1,
+        s.peak_velocity_ratio,
+        s.peak_acceleration_ratio
+    )
 }
 
 /// The warning for a segment that missed its goal.

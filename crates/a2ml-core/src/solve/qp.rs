@@ -8,6 +8,13 @@
 //! bind, a few exact active-set steps on the same Cholesky factor usually find the solution
 //! (verified by the KKT conditions); Clarabel solves the steps where they do not. Clarabel is
 //! used here only.
+//!
+//! The arm's velocity does not jump to each step's answer: the answer is bounded by the
+//! acceleration limits around the velocity the arm has (a box within the velocity box), and
+//! the velocity ramps to it over the step, so q is integrated by the trapezoidal rule and the
+//! samples' q and q' are one piecewise-quadratic motion whose acceleration is within the
+//! limits. Where that box and an obstacle's damper row cannot both hold, the step keeps the
+//! damper (safety first) and the acceleration check of the plan catches the rest.
 
 use std::time::Instant;
 
@@ -16,6 +23,7 @@ use clarabel::solver::{
     DefaultSettings, DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
 
+use super::monitor::Monitor;
 use super::report::{QpStats, Tolerance};
 use crate::collision::{self, CollisionScene, DistanceOptions, Proximity};
 use crate::kinematics::{
@@ -46,6 +54,12 @@ pub struct QpOptions {
     /// Fraction of each joint's speed limit the QP may use, default 0.99 (the rest absorbs
     /// interpolation between samples).
     pub velocity_fraction: Real,
+    /// Fraction of each joint's acceleration limit a step's velocity change may use, default
+    /// 0.9 (the rest absorbs the interpolation of the output between samples).
+    pub acceleration_fraction: Real,
+    /// The acceleration limits used: the robot's times this, default 1 (the task's
+    /// `acceleration` setting).
+    pub acceleration_scale: Real,
     /// d_s, the distance kept from obstacles (m), default 0.01.
     pub safety_distance: Real,
     /// d_i, the influence distance where damper rows start (m), default 0.08.
@@ -70,6 +84,8 @@ impl Default for QpOptions {
             limit_margin: 1e-3,
             limit_gain: 10.0,
             velocity_fraction: 0.99,
+            acceleration_fraction: 0.9,
+            acceleration_scale: 1.0,
             safety_distance: 0.01,
             influence: 0.08,
             damper_speed: 0.5,
@@ -110,6 +126,12 @@ pub enum QpError {
     Hold {
         /// Why.
         reason: String,
+    },
+    /// The wall-clock limit set by the user passed.
+    #[error("timeout at t = {time:.3} s: the time limit passed")]
+    Timeout {
+        /// Segment time (s).
+        time: Real,
     },
     /// The samples do not make a trajectory (non-finite values).
     #[error(transparent)]
@@ -169,6 +191,25 @@ pub fn solve_segment(
     q0: &JointVector,
     options: &QpOptions,
 ) -> Result<QpSolution, QpError> {
+    solve_segment_monitored(robot, scene, problem, q0, options, &mut Monitor::silent())
+}
+
+/// Control steps between two progress reports and deadline checks.
+const REPORT_EVERY: usize = 64;
+
+/// [`solve_segment`], reporting the fraction of the reference's time done to `monitor` and
+/// stopping at its deadline ([`QpError::Timeout`]).
+///
+/// # Errors
+/// As [`solve_segment`].
+pub fn solve_segment_monitored(
+    robot: &Robot,
+    scene: &CollisionScene,
+    problem: &SegmentProblem,
+    q0: &JointVector,
+    options: &QpOptions,
+    monitor: &mut Monitor,
+) -> Result<QpSolution, QpError> {
     check_options(options)?;
     let mut controller = Controller::new(robot, scene, problem, options);
     let h = options.step;
@@ -185,21 +226,29 @@ pub fn solve_segment(
     let mut progress: Vec<Real> = Vec::new();
     let mut max_errors = [0.0; 3];
     let mut q = *q0;
+    // The arm's velocity at the step's start; each segment starts at rest.
+    let mut velocity = JointVector::zeros();
     let mut k = 0;
     let (errors, stalled) = loop {
         let t = k as Real * h_ref;
-        let step = controller.step(&q, t)?;
+        if k % REPORT_EVERY == 0 {
+            if monitor.expired() {
+                return Err(QpError::Timeout { time: t });
+            }
+            monitor.report(t / total.max(h_ref));
+        }
+        let step = controller.step(&q, &velocity, t)?;
         for (m, e) in max_errors.iter_mut().zip(step.errors) {
             *m = Real::max(*m, e);
         }
         times.push(t);
         positions.push(q);
-        velocities.push(step.velocity);
+        velocities.push(velocity);
         if k >= steps {
             // Settling on the goal: stop at rest within tolerance, when progress stalls, or
             // when the time is up.
             let reached = controller.within(&step.errors);
-            let at_rest = step.velocity.amax() <= options.rest_speed;
+            let at_rest = velocity.amax().max(step.velocity.amax()) <= options.rest_speed;
             let score = controller.score(&step.errors);
             progress.push(score);
             let n = progress.len();
@@ -208,25 +257,29 @@ pub fn solve_segment(
                 break (step.errors, !reached && stuck);
             }
         }
-        q += step.velocity * h_ref;
+        // The velocity ramps to the step's answer: the trapezoidal rule is exact.
+        q += (velocity + step.velocity) * (0.5 * h_ref);
+        velocity = step.velocity;
         k += 1;
     };
-    let mut end = times.len() - 1;
-    if velocities[end].amax() > options.rest_speed {
+    if velocity.amax() > options.rest_speed {
         // Stopped short while still moving: hold the state reached until the arm is at rest,
-        // so the next action can start from rest.
+        // so the next action can start from rest. Braking takes as long as the acceleration
+        // limits ask, at most the settle time plus that.
         let hold = controller.hold_problem(&q, options.max_settle.max(h_ref))?;
         let mut brake = Controller::new(robot, scene, &hold, options);
-        let mut t = times[end];
-        for _ in 0..settle_steps.max(1) {
-            q += velocities[end] * h_ref;
+        let start = *times.last().unwrap_or(&0.0);
+        let braking = (velocity.component_div(&brake.acceleration).amax() / h_ref).ceil() as usize;
+        let mut t = start;
+        for _ in 0..settle_steps.max(1) + braking {
+            let step = brake.step(&q, &velocity, t - start)?;
+            q += (velocity + step.velocity) * (0.5 * h_ref);
+            velocity = step.velocity;
             t += h_ref;
-            let step = brake.step(&q, t - times[end])?;
             times.push(t);
             positions.push(q);
-            velocities.push(step.velocity);
-            end += 1;
-            if step.velocity.amax() <= options.rest_speed {
+            velocities.push(velocity);
+            if velocity.amax() <= options.rest_speed {
                 break;
             }
         }
@@ -255,6 +308,11 @@ fn check_options(o: &QpOptions) -> Result<(), QpError> {
         (o.limit_margin.is_finite() && o.limit_margin >= 0.0, "negative limit margin"),
         (positive(o.limit_gain) && o.limit_gain * o.step <= 1.0, "limit gain out of range"),
         (positive(o.velocity_fraction) && o.velocity_fraction <= 1.0, "velocity fraction"),
+        (
+            positive(o.acceleration_fraction) && o.acceleration_fraction <= 1.0,
+            "acceleration fraction",
+        ),
+        (positive(o.acceleration_scale), "the acceleration scale must be positive"),
         (o.safety_distance.is_finite() && o.safety_distance >= 0.0, "negative safety distance"),
         (o.influence.is_finite() && o.influence > o.safety_distance, "influence <= safety"),
         (positive(o.damper_speed), "the damper speed must be positive"),
@@ -283,6 +341,8 @@ struct Controller<'a> {
     lower: JointVector,
     upper: JointVector,
     speed: JointVector,
+    /// The acceleration each step may use (rad/s²).
+    acceleration: JointVector,
     /// Created at the first step where a constraint binds.
     clarabel: Option<Clarabel>,
     timing: Timing,
@@ -304,12 +364,15 @@ impl<'a> Controller<'a> {
             lower: robot.lower(),
             upper: robot.upper(),
             speed: robot.velocity_limits() * options.velocity_fraction,
+            acceleration: robot.acceleration_limits()
+                * (options.acceleration_scale * options.acceleration_fraction),
             clarabel: None,
             timing: Timing::default(),
         }
     }
 
-    fn step(&mut self, q: &JointVector, t: Real) -> Result<Step, QpError> {
+    /// The velocity to ramp to over the step from `q`, where the arm moves at `current`.
+    fn step(&mut self, q: &JointVector, current: &JointVector, t: Real) -> Result<Step, QpError> {
         let started = Instant::now();
         let pose = arm_pose(self.robot, q);
         let singular = |source| QpError::Singular { time: t, source };
@@ -321,12 +384,23 @@ impl<'a> Controller<'a> {
         let p = jacobian.transpose() * weighted + Matrix7::identity() * self.options.regularization;
         let c = weighted.transpose() * target;
         let (lower, upper) = self.bounds(q);
+        let (ramp_lower, ramp_upper) = self.ramp(&lower, &upper, current);
         let rows = self.damper_rows(&pose);
 
-        let exact = p.cholesky().and_then(|ch| structured_solve(&ch, &c, &lower, &upper, &rows));
-        let (velocity, clarabel) = match exact {
+        let cholesky = p.cholesky();
+        let exact = |lower: &Vector7, upper: &Vector7| {
+            cholesky.as_ref().and_then(|ch| structured_solve(ch, &c, lower, upper, &rows))
+        };
+        let (velocity, clarabel) = match exact(&ramp_lower, &ramp_upper) {
             Some(x) => (x, false),
-            None => (self.clarabel_solve(&p, &c, &lower, &upper, &rows, t)?, true),
+            None => match self.clarabel_solve(&p, &c, &ramp_lower, &ramp_upper, &rows, t) {
+                Ok(x) => (x, true),
+                // The damper rows cannot hold within the acceleration box: keep the rows.
+                Err(_) => match exact(&lower, &upper) {
+                    Some(x) => (x, false),
+                    None => (self.clarabel_solve(&p, &c, &lower, &upper, &rows, t)?, true),
+                },
+            },
         };
         self.timing.record(started.elapsed().as_secs_f64(), clarabel);
         Ok(Step { velocity, errors })
@@ -415,6 +489,20 @@ impl<'a> Controller<'a> {
             lower[i] = -self.speed[i].min(k * room_down);
         }
         (lower, upper)
+    }
+
+    /// The velocity box intersected with what the acceleration limits reach from `current` in
+    /// one step. A joint whose braking bound lies beyond that reach brakes as hard as it may.
+    fn ramp(&self, lower: &Vector7, upper: &Vector7, current: &JointVector) -> (Vector7, Vector7) {
+        let reach = self.acceleration * self.options.step;
+        let mut ramp_lower = Vector7::zeros();
+        let mut ramp_upper = Vector7::zeros();
+        for i in 0..DOF {
+            let (lo, hi) = (current[i] - reach[i], current[i] + reach[i]);
+            ramp_lower[i] = lower[i].max(lo).min(hi);
+            ramp_upper[i] = upper[i].min(hi).max(lo);
+        }
+        (ramp_lower, ramp_upper)
     }
 
     /// One row a·x ≤ b per arm-obstacle pair inside the influence distance: the speed at

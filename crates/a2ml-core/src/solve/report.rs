@@ -156,6 +156,24 @@ pub struct SegmentReport {
     pub rrt: Option<crate::solve::rrt::RrtStats>,
     /// Why `auto` went on from the QP to the solver that produced the segment.
     pub fallback: Option<Fallback>,
+    /// The largest |q'_i| / velocity limit_i over the segment's time in the output, at every
+    /// instant of its curve.
+    pub peak_velocity_ratio: Real,
+    /// The largest |q̈_i| / acceleration limit_i over the segment's time in the output.
+    pub peak_acceleration_ratio: Real,
+    /// Whether the output holds every position, velocity and acceleration limit over the
+    /// segment's time.
+    pub limits_kept: bool,
+    /// The factor the segment was slowed down by to keep the limits (1: as solved).
+    pub slowed_down: Real,
+    /// The normalised jerk of the joints' motion over the segment's time in the output
+    /// (dimensionless; a minimum-jerk movement scores about 19).
+    pub joint_jerk: Real,
+    /// The normalised jerk of the wrist's path over the segment's time in the output.
+    pub wrist_jerk: Real,
+    /// The number of peaks of the speed of the segment's featured variable (the first of its
+    /// focus) over the segment as solved: 1 for a human-like movement (paper Rule 5).
+    pub speed_peaks: usize,
 }
 
 /// A planned task: the whole joint trajectory at the output rate and what each segment did.
@@ -182,8 +200,9 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// Whether every segment reached its goals within tolerance and kept its hard path.
+    /// Whether every segment reached its goals within tolerance, kept its hard path and kept
+    /// the joint limits.
     pub fn reached(&self) -> bool {
-        self.segments.iter().all(|s| s.reached && s.path_kept)
+        self.segments.iter().all(|s| s.reached && s.path_kept && s.limits_kept)
     }
 }

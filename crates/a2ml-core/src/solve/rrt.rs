@@ -7,21 +7,27 @@
 //! that each tell how far either way the arm keeps the clearance
 //! ([`crate::collision::advancement`]), so the whole edge keeps `clearance`; the start and the
 //! goals need only keep it themselves. The path is then shortcut. Seeded: the same seed gives
-//! the same path.
+//! the same path, and a search that fails is decided by its sample budget, not by the clock
+//! (a wall-clock limit is the user's option, reported as [`RrtError::Timeout`]).
+//!
+//! [`time_parameterise`] times the shortcut path as one rest-to-rest bell per straight edge,
+//! within the velocity and acceleration limits: the motion is C² and stays on the edges the
+//! checks covered.
 
 use std::time::Instant;
 
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 
+use super::monitor::Monitor;
 use crate::collision::{
     CollisionModel, CollisionScene, advancement_at_least, clearance, min_distance, motion_bound,
 };
 use crate::kinematics::arm_pose;
 use crate::math::{JointVector, Real};
-use crate::profile::{BellProfile, JointSample};
+use crate::profile::BellProfile;
 use crate::robot::Robot;
-use crate::trajectory::{Trajectory, TrajectoryError, sample_times};
+use crate::trajectory::{Limits, Trajectory, TrajectoryError, sample_times};
 
 /// Settings of [`rrt_connect`].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -38,10 +44,11 @@ pub struct RrtOptions {
     pub resolution: Real,
     /// Distance kept from obstacles and between non-adjacent links (m), default 0.01.
     pub clearance: Real,
-    /// Samples before giving up, default 20,000.
+    /// Samples before giving up, default 20,000: what decides that a search failed.
     pub max_samples: usize,
-    /// Wall time before giving up (s), default 5.
-    pub max_time: Real,
+    /// Wall time before giving up (s), default none: a limit the user sets, which makes the
+    /// outcome depend on the machine's speed.
+    pub max_time: Option<Real>,
     /// Shortcut attempts on the found path, default 200.
     pub shortcuts: usize,
 }
@@ -54,7 +61,7 @@ impl Default for RrtOptions {
             resolution: 0.005,
             clearance: 0.01,
             max_samples: 20_000,
-            max_time: 5.0,
+            max_time: None,
             shortcuts: 200,
         }
     }
@@ -121,12 +128,17 @@ pub enum RrtError {
         /// Why.
         reason: String,
     },
-    /// The search ran out of samples or time.
+    /// The wall-clock limit set by the user passed before a path was found.
+    #[error("timeout: the time limit passed after {} samples", stats.samples)]
+    Timeout {
+        /// The search's counters.
+        stats: RrtStats,
+    },
+    /// The search used its sample budget.
     #[error(
-        "no path found in {} samples and {:.2} s; the start tree came within {closest:.3} rad \
-         of the goal tree",
-        stats.samples,
-        stats.time
+        "no path found in {} samples; the start tree came within {closest:.3} rad of the goal \
+         tree",
+        stats.samples
     )]
     NoPath {
         /// Joint-space distance between the closest nodes of the two trees (rad).
@@ -152,7 +164,7 @@ pub struct RrtPath {
 ///
 /// # Errors
 /// [`RrtError`]: invalid settings, an invalid start, no valid goal, or no path within the
-/// sample and time limits.
+/// sample budget ([`RrtError::Timeout`] when the time limit passes first).
 pub fn rrt_connect(
     robot: &Robot,
     scene: &CollisionScene,
@@ -160,7 +172,27 @@ pub fn rrt_connect(
     goals: &[JointVector],
     options: &RrtOptions,
 ) -> Result<RrtPath, RrtError> {
+    rrt_connect_monitored(robot, scene, start, goals, options, &mut Monitor::silent())
+}
+
+/// Samples between two progress reports and deadline checks.
+pub(crate) const REPORT_EVERY: usize = 64;
+
+/// [`rrt_connect`], reporting the fraction of the sample budget used to `monitor` and
+/// stopping at its deadline.
+///
+/// # Errors
+/// As [`rrt_connect`].
+pub fn rrt_connect_monitored(
+    robot: &Robot,
+    scene: &CollisionScene,
+    start: &JointVector,
+    goals: &[JointVector],
+    options: &RrtOptions,
+    monitor: &mut Monitor,
+) -> Result<RrtPath, RrtError> {
     check_options(options)?;
+    let mut monitor = monitor.within(options.max_time);
     let started = Instant::now();
     let mut space = Space::new(robot, scene, options);
     if let Some(reason) = space.invalid(start) {
@@ -187,7 +219,14 @@ pub fn rrt_connect(
             return Ok(RrtPath { waypoints: vec![*start, g], goal: index, stats });
         }
     }
-    while samples < options.max_samples && started.elapsed().as_secs_f64() < options.max_time {
+    while samples < options.max_samples {
+        if samples % REPORT_EVERY == 0 {
+            if monitor.expired() {
+                let nodes = from_start.nodes.len() + from_goal.nodes.len();
+                return Err(RrtError::Timeout { stats: space.stats(samples, nodes, started) });
+            }
+            monitor.report(samples as Real / options.max_samples as Real);
+        }
         samples += 1;
         let sample = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
         let (grow, other) = if swapped {
@@ -237,7 +276,7 @@ pub(crate) fn check_options(o: &RrtOptions) -> Result<(), RrtError> {
         (positive(o.resolution), "the resolution must be positive"),
         (o.clearance.is_finite() && o.clearance >= 0.0, "negative clearance"),
         (o.max_samples > 0, "no samples allowed"),
-        (positive(o.max_time), "the time limit must be positive"),
+        (o.max_time.is_none_or(positive), "the time limit must be positive"),
     ];
     match checks.iter().find(|(ok, _)| !ok) {
         Some((_, reason)) => Err(RrtError::InvalidOptions { reason }),
@@ -493,27 +532,45 @@ fn shortcut(
     path
 }
 
-/// A path timed with the bell profile (paper eq. 9) along its joint-space arc length.
+/// A path timed with bell-shaped speeds (paper eq. 9).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TimedPath {
     /// Samples at the rate asked for, plus the end.
     pub trajectory: Trajectory,
     /// The duration used (s).
     pub duration: Real,
-    /// Whether the duration asked for was stretched to keep every joint within its speed
-    /// limit.
+    /// Whether the duration asked for was stretched to keep every joint within its speed and
+    /// acceleration limits.
     pub stretched: bool,
 }
 
-/// Times `waypoints` with a bell-shaped speed along the path's arc length s: ṡ peaks at 2L/T
-/// mid-way and is zero at both ends. Joint i moves at u_i ṡ on an edge of unit direction u,
-/// so T is stretched to 2L max |u_i| / v_i when `duration` would exceed a speed limit.
+/// The share of a limit that planned timing uses; the rest absorbs the interpolation of the
+/// output between samples.
+pub const LIMIT_FRACTION: Real = 0.95;
+
+/// The shortest rest-to-rest bell over `length` along the unit joint direction `u` that keeps
+/// every joint within [`LIMIT_FRACTION`] of its limits: the bell's peak speed is 2L/T and its
+/// peak acceleration 2πL/T², joint i moving |u_i| times as much.
+pub fn shortest_bell(u: &JointVector, length: Real, limits: &Limits) -> Real {
+    (0..u.len())
+        .map(|i| {
+            let d = length * u[i].abs();
+            let v = LIMIT_FRACTION * limits.velocity[i];
+            let a = LIMIT_FRACTION * limits.acceleration[i];
+            (2.0 * d / v).max((2.0 * crate::math::PI * d / a).sqrt())
+        })
+        .fold(0.0, Real::max)
+}
+
+/// Times `waypoints` as one rest-to-rest bell (paper eq. 9) per straight edge: the speed and
+/// acceleration vanish at every waypoint, so the motion is C² with no velocity step, and it
+/// stays on the edges the collision checks covered. The path takes `duration`, or the sum of
+/// the edges' shortest bells within the limits ([`shortest_bell`]) when that is longer.
 ///
 /// # Errors
-/// [`TrajectoryError`] for fewer than one waypoint, a non-positive rate or duration, or
-/// non-finite values.
+/// [`TrajectoryError`] for no waypoint, a non-positive rate or duration, or non-finite values.
 pub fn time_parameterise(
-    robot: &Robot,
+    limits: &Limits,
     waypoints: &[JointVector],
     duration: Real,
     rate: Real,
@@ -522,35 +579,50 @@ pub fn time_parameterise(
     if !(rate.is_finite() && rate > 0.0) {
         return Err(TrajectoryError::InvalidRate { rate_hz: rate });
     }
-    let edges: Vec<(JointVector, Real)> = waypoints
+    let edges: Vec<(JointVector, JointVector, Real)> = waypoints
         .windows(2)
-        .map(|w| w[1] - w[0])
-        .filter(|d| d.norm() > 0.0)
-        .map(|d| (d / d.norm(), d.norm()))
+        .filter(|w| (w[1] - w[0]).norm() > 0.0)
+        .map(|w| (w[0], (w[1] - w[0]).normalize(), (w[1] - w[0]).norm()))
         .collect();
-    let length: Real = edges.iter().map(|(_, l)| l).sum();
-    let speed = robot.velocity_limits();
-    let needed = edges
+    // Each edge's share of the duration is in proportion to its shortest bell, so that every
+    // edge uses the same share of its limits, and none is stretched unless all are.
+    let shortest: Vec<Real> = edges.iter().map(|(_, u, l)| shortest_bell(u, *l, limits)).collect();
+    let least: Real = shortest.iter().sum();
+    let scale = if least > 0.0 { (duration / least).max(1.0) } else { 1.0 };
+    let bells = edges
         .iter()
-        .flat_map(|(u, _)| (0..u.len()).map(move |i| 2.0 * length * u[i].abs() / speed[i]))
-        .fold(0.0, Real::max);
-    let stretched = needed > duration;
-    let duration = duration.max(needed);
-    let bell = BellProfile::new(duration, length).map_err(TrajectoryError::Join)?;
-    let at = |t: Real| -> JointSample {
-        let (mut s, rate) = (bell.progress(t), bell.speed(t));
-        let mut q = first;
-        for (u, l) in &edges {
-            if s <= *l {
-                return (q + u * s, u * rate);
-            }
-            q += u * *l;
-            s -= l;
+        .zip(&shortest)
+        .map(|((_, _, l), short)| BellProfile::new(short * scale, *l))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(TrajectoryError::Join)?;
+    let total: Real = bells.iter().map(BellProfile::duration).sum();
+    if edges.is_empty() {
+        let trajectory = Trajectory::new(vec![0.0], vec![first], vec![JointVector::zeros()])?;
+        return Ok(TimedPath { trajectory, duration: 0.0, stretched: false });
+    }
+    // The rate's grid plus every waypoint's time, where the motion rests.
+    let mut times = sample_times(0.0, total, rate);
+    let mut start = 0.0;
+    for bell in &bells {
+        start += bell.duration();
+        times.push(start);
+    }
+    times.sort_by(Real::total_cmp);
+    times.dedup_by(|b, a| *b - *a <= 1e-9 / rate);
+    let mut samples = Vec::with_capacity(times.len());
+    let (mut edge, mut edge_start) = (0, 0.0);
+    for &t in &times {
+        while edge + 1 < edges.len() && t > edge_start + bells[edge].duration() {
+            edge_start += bells[edge].duration();
+            edge += 1;
         }
-        (q, JointVector::zeros())
-    };
-    let trajectory = Trajectory::from_fn(sample_times(0.0, duration, rate), at)?;
-    Ok(TimedPath { trajectory, duration, stretched })
+        let (from, u, _) = &edges[edge];
+        let local = t - edge_start;
+        samples.push((from + u * bells[edge].progress(local), u * bells[edge].speed(local)));
+    }
+    let (positions, velocities) = samples.into_iter().unzip();
+    let trajectory = Trajectory::new(times, positions, velocities)?;
+    Ok(TimedPath { trajectory, duration: total, stretched: total > duration * (1.0 + 1e-9) })
 }
 
 /// The length of a joint-space path (rad, Euclidean per edge).

@@ -2,8 +2,10 @@
 //! (DESIGN.md §4, §5) and the checks run on the whole result: joint limits and clearance.
 //!
 //! Entry points: [`Trajectory::new`], [`join_sequential`], [`join_transitional`],
-//! [`check_limits`], [`min_clearance`], [`sample_times`] (the output grid). Between samples q
-//! follows the cubic Hermite curve through the samples' q and q', so the two stay consistent.
+//! [`check_limits`], [`peaks`], [`min_clearance`], [`sample_times`] (the output grid),
+//! [`Trajectory::stretched`]. Between samples q follows the cubic Hermite curve through the
+//! samples' q and q', so the two stay consistent and the limits are checked at every instant
+//! of that curve, not only at the samples.
 
 use crate::collision::{self, CollisionScene};
 use crate::kinematics::arm_pose;
@@ -11,8 +13,11 @@ use crate::math::{DOF, JointVector, Real};
 use crate::profile::{self, JointSample, ProfileError, SequentialOptions, Transition};
 use crate::robot::Robot;
 
+mod limits;
 #[cfg(test)]
 mod tests;
+
+pub use limits::{Limits, Peaks, peaks};
 
 /// Largest |q2(0) - q1(T1)| per joint accepted by [`join_sequential`] (rad).
 pub const SEQUENTIAL_GAP: Real = 1e-6;
@@ -197,6 +202,18 @@ impl Trajectory {
         Self::from_fn(sample_times(self.start(), self.end(), rate_hz), |t| self.sample(t))
     }
 
+    /// The same motion `factor` times slower: times from the start times `factor`, q' divided
+    /// by it. The Hermite curve keeps its shape, so |q'| falls by `factor` and |q̈| by its
+    /// square.
+    pub fn stretched(&self, factor: Real) -> Self {
+        let start = self.start();
+        Self {
+            times: self.times.iter().map(|t| start + (t - start) * factor).collect(),
+            positions: self.positions.clone(),
+            velocities: self.velocities.iter().map(|v| v / factor).collect(),
+        }
+    }
+
     /// `sample` in local time (0 at the first sample).
     fn local(&self) -> impl Fn(Real) -> JointSample + '_ {
         move |t| self.sample(self.start() + t)
@@ -277,44 +294,76 @@ pub enum LimitKind {
     Position,
     /// The joint's speed limit.
     Velocity,
+    /// The joint's acceleration limit.
+    Acceleration,
 }
 
-/// One joint outside one of its limits at one sample.
+/// One joint outside one of its limits at or after one sample.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct LimitViolation {
-    /// Index of the sample.
+    /// Index of the sample, or of the first sample of the interval where the curve between
+    /// samples goes outside.
     pub sample: usize,
     /// Index of the joint (0-6).
     pub joint: usize,
-    /// The position (rad) or velocity (rad/s) at the sample.
+    /// The position (rad), speed (rad/s) or |acceleration| (rad/s²) found.
     pub value: Real,
-    /// The limit exceeded: the lower or upper bound, or ± the speed limit.
+    /// The limit exceeded: the lower or upper bound, ± the speed limit, or the acceleration
+    /// limit.
     pub limit: Real,
-    /// Position or velocity.
+    /// Position, velocity or acceleration.
     pub kind: LimitKind,
 }
 
-/// Every sample and joint outside its position range or speed limit by more than
-/// `tolerance` (rad, rad/s), in sample then joint order.
+/// Every sample or interval and joint outside the robot's limits by more than `tolerance`
+/// (rad, rad/s, rad/s²), as [`check_within`].
 pub fn check_limits(
     trajectory: &Trajectory,
     robot: &Robot,
     tolerance: Real,
 ) -> Vec<LimitViolation> {
-    let (lower, upper, speed) = (robot.lower(), robot.upper(), robot.velocity_limits());
+    check_within(trajectory, &Limits::of(robot), tolerance)
+}
+
+/// Every sample or interval and joint outside its position range, speed or acceleration limit
+/// by more than `tolerance` (rad, rad/s, rad/s²) anywhere on the Hermite curve, in sample then
+/// joint order: a sample's own q and q', then the extremes of the curve up to the next sample.
+pub fn check_within(
+    trajectory: &Trajectory,
+    limits: &Limits,
+    tolerance: Real,
+) -> Vec<LimitViolation> {
+    let (lower, upper, speed) = (limits.lower, limits.upper, limits.velocity);
     let mut out = Vec::new();
+    let mut extremes = limits::intervals(trajectory).peekable();
     for (sample, (q, qd)) in trajectory.positions.iter().zip(&trajectory.velocities).enumerate() {
+        let mut flag = |joint: usize, value: Real, limit: Real, kind| {
+            out.push(LimitViolation { sample, joint, value, limit, kind });
+        };
         for joint in 0..DOF {
-            let mut flag = |value: Real, limit: Real, kind| {
-                out.push(LimitViolation { sample, joint, value, limit, kind });
-            };
             if q[joint] < lower[joint] - tolerance {
-                flag(q[joint], lower[joint], LimitKind::Position);
+                flag(joint, q[joint], lower[joint], LimitKind::Position);
             } else if q[joint] > upper[joint] + tolerance {
-                flag(q[joint], upper[joint], LimitKind::Position);
+                flag(joint, q[joint], upper[joint], LimitKind::Position);
             }
             if qd[joint].abs() > speed[joint] + tolerance {
-                flag(qd[joint], speed[joint].copysign(qd[joint]), LimitKind::Velocity);
+                flag(joint, qd[joint], speed[joint].copysign(qd[joint]), LimitKind::Velocity);
+            }
+        }
+        while let Some((_, joint, [low, high, top, accel])) =
+            extremes.next_if(|(k, _, _)| *k == sample)
+        {
+            if low < lower[joint] - tolerance && q[joint] >= lower[joint] - tolerance {
+                flag(joint, low, lower[joint], LimitKind::Position);
+            } else if high > upper[joint] + tolerance && q[joint] <= upper[joint] + tolerance {
+                flag(joint, high, upper[joint], LimitKind::Position);
+            }
+            if top > speed[joint] + tolerance && qd[joint].abs() <= speed[joint] + tolerance {
+                flag(joint, top, speed[joint], LimitKind::Velocity);
+            }
+            let a = limits.acceleration[joint];
+            if accel > a + tolerance {
+                flag(joint, accel, a, LimitKind::Acceleration);
             }
         }
     }

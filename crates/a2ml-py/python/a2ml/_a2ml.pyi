@@ -518,6 +518,34 @@ class SegmentReport:
     def fallback(self) -> Literal["qp_stalled", "qp_missed_goal", "qp_left_path"] | None:
         """Why ``auto`` went on from the QP to the solver named, else None."""
 
+    @property
+    def peak_velocity_ratio(self) -> float:
+        """The largest |q'| / velocity limit of any joint over the segment's time in the output."""
+
+    @property
+    def peak_acceleration_ratio(self) -> float:
+        """The largest |q''| / acceleration limit of any joint over the segment's time in the output."""
+
+    @property
+    def limits_kept(self) -> bool:
+        """Whether the output holds every position, velocity and acceleration limit over the segment."""
+
+    @property
+    def slowed_down(self) -> float:
+        """The factor the segment was slowed down by to keep the limits (1: as solved)."""
+
+    @property
+    def joint_jerk(self) -> float:
+        """The normalised jerk of the joints over the segment (dimensionless)."""
+
+    @property
+    def wrist_jerk(self) -> float:
+        """The normalised jerk of the wrist path over the segment (dimensionless)."""
+
+    @property
+    def speed_peaks(self) -> int:
+        """The number of peaks of the featured variable's speed (1: one bell)."""
+
     def to_dict(self) -> dict[str, Any]:
         """Every field above in one dict (records as their NamedTuples), e.g.
         for ``pandas.DataFrame([s.to_dict() for s in plan.segments])``."""
@@ -620,6 +648,8 @@ def plan(
     rate: float | None = None,
     seed: int | None = None,
     robot: Robot | None = None,
+    acceleration_scale: float | None = None,
+    time_limit: float | None = None,
 ) -> Plan:
     """Plan a task (DESIGN.md §4-5): decompose it, solve every segment from
     where the last one really ended and join them (+Tr within an action, +Se
@@ -630,7 +660,13 @@ def plan(
     every action (default: theirs; ``"map"`` is not available yet; ``"gpm"``,
     ``"clik"`` and ``"pmp"`` are the baselines). ``rate`` (Hz) overrides the task's
     ``settings { rate }`` (default 100 Hz); ``seed`` its ``seed``. ``robot``
-    defaults to the task's robot file (:attr:`Task.robot`). A goal missed
+    defaults to the task's robot file (:attr:`Task.robot`).
+    ``acceleration_scale`` multiplies the robot's acceleration limits
+    (overriding ``settings { acceleration }``); ``time_limit`` (s, default
+    none) makes the plan fail with a timeout once it passes. Every joint
+    holds its position, velocity and acceleration limits at every instant of
+    the output; a segment that cannot is named in :attr:`Plan.warnings`
+    and is not reached. A goal missed
     beyond tolerance is not an error: :attr:`Plan.reached` is False and
     :attr:`Plan.warnings` say which. Deterministic; releases the GIL.
 
