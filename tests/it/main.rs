@@ -5,6 +5,7 @@ mod common;
 mod constrained_rrt;
 mod decompose;
 mod errors;
+mod hostile;
 mod ik;
 mod jacobians;
 mod language;

@@ -47,6 +47,8 @@ pub struct ExplainArgs {
     /// Print JSON instead of the tree.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub limits: super::LimitArgs,
 }
 
 /// Runs `a2ml explain`.
@@ -56,7 +58,7 @@ pub struct ExplainArgs {
 /// [`CliError::Input`] when the task is invalid (its diagnostics go to
 /// stderr first), the robot is unusable, or the decomposition fails.
 pub fn run(args: &ExplainArgs) -> Result<(), CliError> {
-    let (task, _) = super::load_task(&args.file)?;
+    let (task, _) = super::load_task(&args.file, &args.limits.limits())?;
     let robot = Robot::from_urdf_file(&task.robot)?;
     let decomposition = decompose::decompose(&robot, &task, &DecomposeOptions::default())
         .map_err(|e| CliError::Input(format!("{}: {e}", args.file.display())))?;

@@ -12,10 +12,12 @@ use clap::Args;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 
 use a2ml_core::Robot;
-use a2ml_core::language::{SolverChoice, Task, Variable};
+use a2ml_core::language::{self, SolverChoice, Task, Variable};
 use a2ml_core::math::Real;
 use a2ml_core::output::{self as files, OutputError, Staged};
-use a2ml_core::solve::{self, Plan, PlanOptions, Progress, SegmentReport, SolveError, Tolerance};
+use a2ml_core::solve::{
+    self, CheckError, Plan, PlanOptions, Progress, SegmentReport, SolveError, Tolerance,
+};
 
 use crate::error::CliError;
 use crate::output::{self, COARSE, Table, deg, num};
@@ -70,6 +72,12 @@ pub struct PlanArgs {
     /// Seed of the randomised solvers, overriding the task's `settings { seed }`.
     #[arg(long, value_name = "N")]
     pub seed: Option<u64>,
+    /// Plan even when the task or an action starts closer to an obstacle than the safety
+    /// distance (or in collision), with a warning.
+    #[arg(long)]
+    pub allow_close_start: bool,
+    #[command(flatten)]
+    pub limits: super::LimitArgs,
 }
 
 /// `--solver`: one of [`SolverChoice::NAMES`], listed in `--help`.
@@ -121,7 +129,8 @@ pub fn run(args: &PlanArgs, temporaries: &Temporaries) -> Result<(), CliError> {
             )));
         }
     }
-    let (mut task, source) = super::load_task(&args.file)?;
+    let limits = args.limits.limits();
+    let (mut task, source) = super::load_task(&args.file, &limits)?;
     if let Some(seed) = args.seed {
         task.settings.seed = seed;
     }
@@ -129,13 +138,24 @@ pub fn run(args: &PlanArgs, temporaries: &Temporaries) -> Result<(), CliError> {
         output::check_not_an_input(path, &[&args.file, &task.robot])?;
     }
     let robot = Robot::from_urdf_file(&task.robot)?;
-    let options = PlanOptions { solver: args.solver, rate: args.rate, ..PlanOptions::default() };
+    let options = PlanOptions {
+        solver: args.solver,
+        rate: args.rate,
+        limits,
+        allow_close_start: args.allow_close_start,
+        ..PlanOptions::default()
+    };
 
     let started = Instant::now();
     let mut bar = ProgressBar::new(started);
     let result = solve::plan_with_progress(&robot, &task, &options, &mut |p| bar.update(p));
     bar.clear();
-    let plan = result.map_err(|e| solve_error(&args.file, e))?;
+    let plan = result.map_err(|e| {
+        if let SolveError::Check(CheckError::StartTooClose { action_index, order, .. }) = &e {
+            report_start(&args.file, &source, *action_index, *order, &e.to_string());
+        }
+        solve_error(&args.file, e)
+    })?;
     let planning_time = started.elapsed();
 
     for warning in &plan.warnings {
@@ -221,12 +241,37 @@ fn solve_error(file: &Path, error: SolveError) -> CliError {
     match error {
         SolveError::Decompose(_)
         | SolveError::InvalidRate { .. }
+        | SolveError::Check(_)
         | SolveError::UnsupportedSolver { .. } => CliError::Input(message),
         SolveError::Reference { .. }
         | SolveError::Qp { .. }
         | SolveError::Rrt { .. }
         | SolveError::Trajectory(_) => CliError::Planning(message),
     }
+}
+
+/// Shows where a start too close to an obstacle is written: the task's `start` for the first
+/// action (or the action's name when there is no `start`), else the action.
+fn report_start(file: &Path, source: &str, action_index: usize, order: usize, message: &str) {
+    let Ok(ast) = language::parse_ast(source, Some(file)) else { return };
+    let start = ast.items.iter().find_map(|item| match item {
+        language::ast::Item::Start(language::ast::Start::Joints(v)) => Some(v.span),
+        language::ast::Item::Start(language::ast::Start::State { span, .. }) => Some(*span),
+        _ => None,
+    });
+    let action = ast.items.iter().find_map(|item| match item {
+        language::ast::Item::Task(t) => t.actions.get(action_index).map(|a| a.name.span),
+        _ => None,
+    });
+    let Some(span) = (if order == 0 { start.or(action) } else { action }) else { return };
+    let hint = "plan anyway, with a warning, with --allow-close-start";
+    let diagnostics = language::Diagnostics {
+        path: Some(file.display().to_string()),
+        source: source.to_owned(),
+        items: vec![language::Diagnostic::new(span, message).with_help(hint)],
+        omitted: 0,
+    };
+    output::report(&diagnostics.to_string());
 }
 
 /// The summary: the task, one row per segment, then the totals.
@@ -429,6 +474,13 @@ mod tests {
             solver: None,
             rate: None,
             seed: None,
+            allow_close_start: false,
+            limits: crate::commands::LimitArgs {
+                max_samples: 1,
+                max_segments: 1,
+                max_errors: 1,
+                max_input_bytes: 1,
+            },
         };
         assert_eq!(outputs(&args), vec![(Format::Mcap, PathBuf::from("lines.mcap"))]);
         let args = PlanArgs { csv: Some(PathBuf::from("x.csv")), ..args };

@@ -5,11 +5,14 @@
 //! [`rrt::rrt_connect`] (a collision-free joint-space path) and
 //! [`constrained_rrt::constrained_rrt`] (one that keeps a segment's path constraint exactly).
 
+mod assembly;
+mod checks;
 pub mod constrained_rrt;
 mod plan;
 pub mod qp;
 mod report;
 pub mod rrt;
 
+pub use checks::CheckError;
 pub use plan::{PlanOptions, Progress, SolveError, plan, plan_with_progress};
 pub use report::{Fallback, Plan, QpStats, SegmentReport, Tolerance, VariableError};

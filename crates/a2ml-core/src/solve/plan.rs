@@ -1,6 +1,8 @@
 //! A whole task: decompose, solve every segment from where the last one really ended, join
 //! segments (+Tr within an action, +Se between actions) and report on each.
 
+use super::assembly::Assembly;
+use super::checks::{self, CheckError};
 use super::constrained_rrt::{Chart, constrained_rrt, time_constrained};
 use super::qp::{self, Component, QpError, QpOptions, SegmentProblem};
 use super::report::{Fallback, Plan, QpStats, SegmentReport, VariableError};
@@ -11,7 +13,9 @@ use crate::decompose::{
     decompose, goal_error,
 };
 use crate::kinematics::{HatState, hat_to_cpsa, ik_cpsa};
-use crate::language::{ActionBody, PrimitiveConstraint, SolverChoice, Space, Task, Variable};
+use crate::language::{
+    ActionBody, Limits, PrimitiveConstraint, SolverChoice, Space, Task, Variable,
+};
 use crate::math::{DOF, JointVector, Real, Vector3};
 use crate::profile::{BodyFrames, ProfileError, Reference, Role, Sample};
 use crate::robot::Robot;
@@ -30,6 +34,11 @@ pub struct PlanOptions {
     pub solver: Option<SolverChoice>,
     /// Output rate (Hz), overriding the task's `settings { rate }`.
     pub rate: Option<Real>,
+    /// How large a motion may be planned (samples, segments).
+    pub limits: Limits,
+    /// A start (of the task or an action) closer to an obstacle than the safety distance is
+    /// a warning rather than an error.
+    pub allow_close_start: bool,
 }
 
 /// How far planning has got, for progress displays.
@@ -100,6 +109,9 @@ pub enum SolveError {
         /// Why.
         source: QpError,
     },
+    /// The decomposed task is too large, or an action starts too close to an obstacle.
+    #[error(transparent)]
+    Check(#[from] CheckError),
     /// Joining or resampling the segments failed.
     #[error("joining the segments: {0}")]
     Trajectory(#[from] TrajectoryError),
@@ -132,6 +144,16 @@ pub fn plan_with_progress(
     }
     let decomposition = decompose(robot, task, &options.decompose)?;
     let task_b = task.in_base_frame(&robot.structure.shoulder_in_base_link);
+    let close_starts = checks::before_solving(
+        robot,
+        &task_b,
+        &decomposition,
+        rate,
+        1.0 / options.qp.step,
+        options.qp.safety_distance,
+        &options.limits,
+        options.allow_close_start,
+    )?;
     let total = decomposition.actions.iter().map(|a| a.segments.len()).sum();
     let mut state = Solver {
         robot,
@@ -139,7 +161,7 @@ pub fn plan_with_progress(
         options,
         rate,
         q: decomposition.start,
-        whole: None,
+        whole: Assembly::default(),
         segments: Vec::with_capacity(total),
         wrist_reference: Vec::new(),
         notes: Vec::new(),
@@ -149,12 +171,15 @@ pub fn plan_with_progress(
             progress(&Progress { done, total, action: action.name.clone() })
         })?;
     }
-    let whole = match state.whole {
+    let whole = match state.whole.finish()? {
         Some(w) => w.resample(rate)?,
         // No action: the arm stays at the start.
         None => Trajectory::new(vec![0.0], vec![decomposition.start], vec![JointVector::zeros()])?,
     };
-    let mut warnings = state.notes;
+    let mut warnings = close_starts;
+    warnings.extend(state.notes);
+    let safety = options.qp.safety_distance;
+    warnings.extend(state.segments.iter().filter_map(|s| checks::too_close(s, safety)));
     warnings.extend(state.segments.iter().filter(|s| !s.reached).map(missed));
     warnings.extend(state.segments.iter().filter(|s| !s.path_kept).map(left_path));
     Ok(Plan {
@@ -177,7 +202,7 @@ struct Solver<'a> {
     rate: Real,
     /// Where the arm really is: the end of what has been solved.
     q: JointVector,
-    whole: Option<Trajectory>,
+    whole: Assembly,
     segments: Vec<SegmentReport>,
     wrist_reference: Vec<(Real, Vector3)>,
     /// Warnings other than missed goals: fallbacks and stretched durations.
@@ -222,8 +247,8 @@ impl Solver<'_> {
             &self.task.actions[action.index].body,
             ActionBody::Constraints { path: Some(path), .. } if path.hard
         );
-        let action_start = self.whole.as_ref().map_or(0.0, Trajectory::end);
-        let mut joined: Option<Trajectory> = None;
+        let action_start = self.whole.end().unwrap_or(0.0);
+        let mut joined = Assembly::default();
         let mut last: Option<(Real, Real)> = None; // (start, duration) of the previous segment
         for (k, segment) in action.segments.iter().enumerate() {
             let problem = self.problem(action, k, segment)?;
@@ -245,15 +270,17 @@ impl Solver<'_> {
             };
             let solution = self.solve(&job)?;
             let duration = solution.trajectory.duration();
-            let (start, next) = match (joined.take(), last) {
-                (Some(before), Some((prev_start, prev_duration))) => {
+            let start = match last {
+                Some((prev_start, prev_duration)) => {
                     let overlap = self.task.settings.transition * prev_duration.min(duration);
-                    let start = prev_start + prev_duration - overlap;
-                    (start, trajectory::join_transitional(&before, &solution.trajectory, overlap)?)
+                    joined.join_transitional(&solution.trajectory, overlap)?;
+                    prev_start + prev_duration - overlap
                 }
-                _ => (action_start, shifted(&solution.trajectory, action_start)?),
+                None => {
+                    joined.join_sequential(&shifted(&solution.trajectory, action_start)?)?;
+                    action_start
+                }
             };
-            joined = Some(next);
             last = Some((start, duration));
             if let Some(end) = solution.trajectory.positions().last() {
                 self.q = *end;
@@ -263,11 +290,8 @@ impl Solver<'_> {
             self.segments.push(report);
             solved(self.segments.len());
         }
-        if let Some(action_trajectory) = joined {
-            self.whole = Some(match self.whole.take() {
-                Some(before) => trajectory::join_sequential(&before, &action_trajectory)?,
-                None => action_trajectory,
-            });
+        if let Some(action_trajectory) = joined.finish()? {
+            self.whole.join_sequential(&action_trajectory)?;
         }
         Ok(())
     }
