@@ -122,7 +122,7 @@ mod malformed {
     malformed!(strips_unknown_fact, 6, 11, "fact `holdin` is never true");
     malformed!(strips_goal_unreachable, 4, 10, "fact `box_aside` is never true");
     malformed!(strips_init_without_goal, 3, 8, "also needs a `goal { .. }`");
-    malformed!(bad_seed, 2, 17, "the seed is a non-negative whole number");
+    malformed!(bad_seed, 2, 17, "the seed is a whole number from 0 to 18446744073709551615");
     malformed!(unknown_contact, 5, 15, "unknown obstacle `box_aa`");
     malformed!(contact_without_scene, 5, 15, "unknown obstacle `box_a`");
     malformed!(duplicate_contact, 5, 22, "obstacle `box_a` is listed twice");

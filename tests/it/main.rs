@@ -7,6 +7,7 @@ mod constrained_rrt;
 mod decompose;
 mod errors;
 mod hamp;
+mod hostile;
 mod ik;
 mod jacobians;
 mod language;

@@ -533,11 +533,12 @@ fn a_failed_write_leaves_no_file() {
     assert!(matches!(&err, OutputError::Io { path, .. } if path.ends_with("plan.mcap")), "{err}");
     let a2ml_error: a2ml::Error = err.into();
     assert!(a2ml_error.to_string().contains("plan.mcap"));
-    // A folder in the way of the target: the rename fails after the whole file was written.
+    // A folder in the way of the target is refused before anything is written.
     let blocked = dir.join("plan.csv");
     fs::create_dir(&blocked).expect("folder");
-    assert!(matches!(write_csv(&blocked, &robot, &plan), Err(OutputError::Io { .. })));
-    assert!(matches!(write_json(&blocked, &robot, &task, &plan), Err(OutputError::Io { .. })));
+    assert!(matches!(write_csv(&blocked, &robot, &plan), Err(OutputError::NotRegularFile { .. })));
+    let json = write_json(&blocked, &robot, &task, &plan);
+    assert!(matches!(json, Err(OutputError::NotRegularFile { .. })));
     let left: Vec<_> =
         fs::read_dir(&dir).expect("readable").map(|e| e.expect("entry").file_name()).collect();
     assert_eq!(left, ["plan.csv"], "only the folder itself");

@@ -24,6 +24,8 @@ pub struct CheckArgs {
     /// The task files.
     #[arg(required = true, value_name = "FILE")]
     pub files: Vec<PathBuf>,
+    #[command(flatten)]
+    pub limits: super::LimitArgs,
 }
 
 /// Runs `a2ml check`: every file is checked and reported, whatever the
@@ -34,9 +36,10 @@ pub struct CheckArgs {
 /// when a file is invalid; either with a one-line summary.
 pub fn run(args: &CheckArgs) -> Result<(), CliError> {
     let mut tally = FileTally::default();
+    let limits = args.limits.limits();
     for path in &args.files {
         tally.files += 1;
-        match language::load(path) {
+        match language::load_with(path, &limits) {
             Ok(task) => output::print(&format!(
                 "{}: ok (task {}, {})\n",
                 path.display(),

@@ -50,6 +50,8 @@ pub struct ExplainArgs {
     /// Which chain of the URDF, and where its capsules come from.
     #[command(flatten)]
     pub arm: crate::args::ArmArgs,
+    #[command(flatten)]
+    pub limits: super::LimitArgs,
 }
 
 /// Runs `a2ml explain`.
@@ -59,7 +61,7 @@ pub struct ExplainArgs {
 /// [`CliError::Input`] when the task is invalid (its diagnostics go to
 /// stderr first), the robot is unusable, or the decomposition fails.
 pub fn run(args: &ExplainArgs) -> Result<(), CliError> {
-    let (task, _) = super::load_task(&args.file)?;
+    let (task, _) = super::load_task(&args.file, &args.limits.limits())?;
     let options = args.arm.options(task.robot_base.as_deref(), task.robot_tip.as_deref())?;
     let robot = Robot::from_urdf_file_with(&task.robot, &options)?;
     let decomposition = decompose::decompose(&robot, &task, &DecomposeOptions::default())

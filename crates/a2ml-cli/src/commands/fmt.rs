@@ -54,7 +54,7 @@ pub fn run(args: &FmtArgs) -> Result<(), CliError> {
     let mut tally = FileTally::default();
     for path in &args.files {
         tally.files += 1;
-        let text = match fs::read_to_string(path) {
+        let text = match language::read_source(path, &language::Limits::default()) {
             Ok(text) => text,
             Err(e) => {
                 output::report(&format!("error: cannot read {}: {e}", path.display()));

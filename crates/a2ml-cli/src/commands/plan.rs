@@ -12,10 +12,12 @@ use clap::Args;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 
 use a2ml_core::Robot;
-use a2ml_core::language::{SolverChoice, Task, Variable};
+use a2ml_core::language::{self, SolverChoice, Task, Variable};
 use a2ml_core::math::Real;
 use a2ml_core::output::{self as files, OutputError, Staged};
-use a2ml_core::solve::{self, Plan, PlanOptions, Progress, SegmentReport, SolveError, Tolerance};
+use a2ml_core::solve::{
+    self, CheckError, Plan, PlanOptions, Progress, SegmentReport, SolveError, Tolerance,
+};
 
 use crate::error::CliError;
 use crate::output::{self, COARSE, Table, deg, num};
@@ -81,6 +83,12 @@ pub struct PlanArgs {
     /// when it passes, so the result then depends on the machine's speed.
     #[arg(long, value_name = "SECONDS", value_parser = parse_positive)]
     pub time_limit: Option<Real>,
+    /// Plan even when the task or an action starts closer to an obstacle than the safety
+    /// distance (or in collision), with a warning.
+    #[arg(long)]
+    pub allow_close_start: bool,
+    #[command(flatten)]
+    pub limits: super::LimitArgs,
 }
 
 /// A positive, finite number.
@@ -144,7 +152,8 @@ pub fn run(args: &PlanArgs, temporaries: &Temporaries) -> Result<(), CliError> {
             )));
         }
     }
-    let (mut task, source) = super::load_task(&args.file)?;
+    let limits = args.limits.limits();
+    let (mut task, source) = super::load_task(&args.file, &limits)?;
     if let Some(seed) = args.seed {
         task.settings.seed = seed;
     }
@@ -158,6 +167,8 @@ pub fn run(args: &PlanArgs, temporaries: &Temporaries) -> Result<(), CliError> {
         rate: args.rate,
         acceleration_scale: args.acceleration_scale,
         time_limit: args.time_limit,
+        limits,
+        allow_close_start: args.allow_close_start,
         ..PlanOptions::default()
     };
 
@@ -165,7 +176,12 @@ pub fn run(args: &PlanArgs, temporaries: &Temporaries) -> Result<(), CliError> {
     let mut bar = ProgressBar::new(started);
     let result = solve::plan_with_progress(&robot, &task, &options, &mut |p| bar.update(p));
     bar.clear();
-    let plan = result.map_err(|e| solve_error(&args.file, e))?;
+    let plan = result.map_err(|e| {
+        if let SolveError::Check(CheckError::StartTooClose { action_index, order, .. }) = &e {
+            report_start(&args.file, &source, *action_index, *order, &e.to_string());
+        }
+        solve_error(&args.file, e)
+    })?;
     let planning_time = started.elapsed();
 
     for warning in &plan.warnings {
@@ -270,6 +286,7 @@ pub(crate) fn solve_error(file: &Path, error: SolveError) -> CliError {
         | SolveError::InvalidRate { .. }
         | SolveError::NoArmGeometry { .. }
         | SolveError::InvalidAccelerationScale { .. }
+        | SolveError::Check(_)
         | SolveError::UnsupportedSolver { .. } => CliError::Input(message),
         SolveError::Reference { .. }
         | SolveError::Qp { .. }
@@ -278,6 +295,30 @@ pub(crate) fn solve_error(file: &Path, error: SolveError) -> CliError {
         | SolveError::Baseline { .. }
         | SolveError::Trajectory(_) => CliError::Planning(message),
     }
+}
+
+/// Shows where a start too close to an obstacle is written: the task's `start` for the first
+/// action (or the action's name when there is no `start`), else the action.
+fn report_start(file: &Path, source: &str, action_index: usize, order: usize, message: &str) {
+    let Ok(ast) = language::parse_ast(source, Some(file)) else { return };
+    let start = ast.items.iter().find_map(|item| match item {
+        language::ast::Item::Start(language::ast::Start::Joints(v)) => Some(v.span),
+        language::ast::Item::Start(language::ast::Start::State { span, .. }) => Some(*span),
+        _ => None,
+    });
+    let action = ast.items.iter().find_map(|item| match item {
+        language::ast::Item::Task(t) => t.actions.get(action_index).map(|a| a.name.span),
+        _ => None,
+    });
+    let Some(span) = (if order == 0 { start.or(action) } else { action }) else { return };
+    let hint = "plan anyway, with a warning, with --allow-close-start";
+    let diagnostics = language::Diagnostics {
+        path: Some(file.display().to_string()),
+        source: source.to_owned(),
+        items: vec![language::Diagnostic::new(span, message).with_help(hint)],
+        omitted: 0,
+    };
+    output::report(&diagnostics.to_string());
 }
 
 /// The summary: the task, one row per segment, then the totals.
@@ -499,6 +540,13 @@ mod tests {
             arm: crate::args::ArmArgs::default(),
             acceleration_scale: None,
             time_limit: None,
+            allow_close_start: false,
+            limits: crate::commands::LimitArgs {
+                max_samples: 1,
+                max_segments: 1,
+                max_errors: 1,
+                max_input_bytes: 1,
+            },
         };
         assert_eq!(outputs(&args), vec![(Format::Mcap, PathBuf::from("lines.mcap"))]);
         let args = PlanArgs { csv: Some(PathBuf::from("x.csv")), ..args };

@@ -93,6 +93,11 @@ pub fn parse_configuration(text: &str) -> Result<Configuration, String> {
 /// holds no usable 7-joint arm or a link name is unknown.
 pub fn run(args: &RobotArgs) -> Result<(), CliError> {
     let options = args.arm.options(None, None)?;
+    // A device or a pipe would be read without end.
+    if std::fs::metadata(&args.urdf).is_ok_and(|m| !m.is_file()) {
+        let path = args.urdf.display();
+        return Err(CliError::Input(format!("{path} is not a regular file, so not a URDF")));
+    }
     let robot = Robot::from_urdf_file_with(&args.urdf, &options)?;
     let q = args.at.map(|Configuration(values)| {
         JointVector::from_fn(|i, _| if args.deg { values[i].to_radians() } else { values[i] })

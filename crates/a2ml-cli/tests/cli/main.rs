@@ -3,6 +3,7 @@
 
 mod analyze;
 mod compare;
+mod bounds;
 mod explain;
 mod language;
 mod outputs;

@@ -4,7 +4,8 @@
 //! Entry points: [`CollisionScene::new`], [`arm_capsules`], [`distances`],
 //! [`min_distance`]; for many configurations of one scene (sampling
 //! planners), [`CollisionModel`] with [`clearance`], [`advancement`] (and
-//! [`advancement_at_least`]) and [`motion_bound`]. Everything is in {b}, SI
+//! [`advancement_at_least`]) and [`motion_bound`]; [`check_shapes`] before any query, so
+//! that no pair is skipped for a shape parry cannot handle. Everything is in {b}, SI
 //! units. parry enters the crate here only; its glam types never leave this
 //! module.
 
@@ -17,8 +18,10 @@ use crate::language::{Obstacle, Shape};
 use crate::math::{Real, Vector3};
 use crate::robot::{LinkRole, Robot};
 
+mod guard;
 mod model;
 
+pub use guard::{ShapeError, check_shapes};
 pub use model::{CollisionModel, advancement, advancement_at_least, clearance, motion_bound};
 
 /// The task's obstacles as parry shapes, positioned in {b}.

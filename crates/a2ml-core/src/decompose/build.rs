@@ -131,6 +131,7 @@ pub fn decompose(
     // Lines, axes and rotations are the same in the root frame and in {b};
     // positions move by the shoulder centre.
     let task = &task.in_base_frame(&robot.structure.shoulder_in_base_link);
+    crate::collision::check_shapes(robot, &task.scene)?;
     let start = start_configuration(robot, task)?;
     let order = order_with(task, &options.strips)?;
     let mut q = start;

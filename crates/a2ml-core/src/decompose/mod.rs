@@ -26,6 +26,9 @@ use crate::language::Variable;
 /// Why a task cannot be decomposed.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum DecomposeError {
+    /// An arm capsule or an obstacle cannot be checked for collisions.
+    #[error(transparent)]
+    Shape(#[from] crate::collision::ShapeError),
     /// Some goal facts never become true, whatever the order of the actions.
     #[error(
         "task `{task}`: goal {} can never become true: {} not in `init`, and no action \

@@ -7,6 +7,7 @@
 //! syntax node keeps the byte span of its text.
 
 pub mod ast;
+mod bounds;
 mod diagnostic;
 mod format;
 mod syntax;
@@ -15,6 +16,7 @@ mod validate;
 
 use std::path::Path;
 
+pub use bounds::{Limits, MAX_ANGLE, MAX_LENGTH, ReadError, read_source, samples};
 pub use diagnostic::{Diagnostic, Diagnostics};
 pub use format::format;
 pub use task::*;
@@ -36,7 +38,12 @@ pub enum LanguageError {
 }
 
 fn diagnostics(text: &str, path: Option<&Path>, items: Vec<Diagnostic>) -> Diagnostics {
-    Diagnostics { path: path.map(|p| p.display().to_string()), source: text.to_owned(), items }
+    Diagnostics {
+        path: path.map(|p| p.display().to_string()),
+        source: text.to_owned(),
+        items,
+        omitted: 0,
+    }
 }
 
 /// Parses text into its syntax tree (no validation).
@@ -53,9 +60,21 @@ pub fn parse_ast(text: &str, path: Option<&Path>) -> Result<ast::File, Diagnosti
 /// # Errors
 /// Every problem found, located.
 pub fn parse(text: &str, path: Option<&Path>) -> Result<Task, Diagnostics> {
+    parse_with(text, path, &Limits::default())
+}
+
+/// [`parse`] within `limits`: what the task may ask for, and how many errors are reported
+/// (the rest are counted in [`Diagnostics::omitted`]).
+///
+/// # Errors
+/// Every problem found, located, up to `limits.max_errors`.
+pub fn parse_with(text: &str, path: Option<&Path>, limits: &Limits) -> Result<Task, Diagnostics> {
     let file = parse_ast(text, path)?;
     let base_dir = path.map(|p| p.parent().unwrap_or(Path::new("")));
-    validate::validate(&file, base_dir).map_err(|items| diagnostics(text, path, items))
+    validate::validate(&file, text, base_dir, limits).map_err(|mut items| {
+        let omitted = bounds::keep_first_errors(&mut items, limits);
+        Diagnostics { omitted, ..diagnostics(text, path, items) }
+    })
 }
 
 /// Reads, parses and validates a task file.
@@ -63,10 +82,18 @@ pub fn parse(text: &str, path: Option<&Path>) -> Result<Task, Diagnostics> {
 /// # Errors
 /// [`LanguageError::Io`] or every problem found.
 pub fn load(path: impl AsRef<Path>) -> Result<Task, LanguageError> {
+    load_with(path, &Limits::default())
+}
+
+/// [`load`] within `limits` ([`parse_with`]; at most `limits.max_input_bytes` are read).
+///
+/// # Errors
+/// As [`load`].
+pub fn load_with(path: impl AsRef<Path>, limits: &Limits) -> Result<Task, LanguageError> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|e| LanguageError::Io {
+    let text = read_source(path, limits).map_err(|e| LanguageError::Io {
         path: path.display().to_string(),
         message: e.to_string(),
     })?;
-    parse(&text, Some(path)).map_err(LanguageError::Invalid)
+    parse_with(&text, Some(path), limits).map_err(LanguageError::Invalid)
 }

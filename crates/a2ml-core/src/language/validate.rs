@@ -6,6 +6,7 @@ use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 
 use super::ast::{self, Name, Span};
+use super::bounds::{self, Limits, MAX_ANGLE, MAX_LENGTH};
 use super::diagnostic::Diagnostic;
 use super::task::*;
 use crate::math::{DOF, JointVector, Matrix3, PI, Real, Rotation3, UnitQuaternion, Vector3};
@@ -57,6 +58,13 @@ type Group = (Vec<Name>, Vec<Variable>, Option<PrimitiveConstraint>);
 struct Checker<'a> {
     errors: Vec<Diagnostic>,
     base_dir: Option<&'a Path>,
+    /// The text the spans point into (the seed is read from it: every u64, exactly).
+    source: &'a str,
+    limits: &'a Limits,
+    /// Every duration written, in file order, for the sample limit.
+    durations: Vec<(Span, Real)>,
+    /// Where the rate is written.
+    rate_span: Span,
     /// Every obstacle name the scene declares, shapes valid or not, so that
     /// a bad shape is not reported again at each `contact` naming it.
     obstacles: Vec<String>,
@@ -125,6 +133,17 @@ impl Checker<'_> {
             self.error(q.span, "the number is too large");
             return None;
         }
+        if let Some(message) = beyond_bound(v, dimension) {
+            self.error(q.span, message);
+            return None;
+        }
+        Some(v)
+    }
+
+    /// A positive duration, noted for the sample limit.
+    fn duration(&mut self, q: &ast::Quantity, what: &str) -> Option<Real> {
+        let v = self.positive(q, Dimension::Time, what)?;
+        self.durations.push((q.span, v));
         Some(v)
     }
 
@@ -157,6 +176,10 @@ impl Checker<'_> {
             self.error(v.span, "a number is too large");
             return None;
         }
+        if let Some(message) = out.iter().find_map(|x| beyond_bound(*x, dimension)) {
+            self.error(v.span, message);
+            return None;
+        }
         Some(out)
     }
 
@@ -169,7 +192,12 @@ impl Checker<'_> {
             self.error(unit.span, format!("{what} is a direction and takes no unit"));
             return None;
         }
-        let d = self.vector3(v, Dimension::Length, what)?;
+        // A direction is not a length: no workspace bound, and scaled before its norm is
+        // taken, which would overflow for components near the largest number.
+        let d = self.numbers(v, Dimension::Fraction, 3, what)?;
+        let d = Vector3::new(d[0], d[1], d[2]);
+        let scale = d.amax();
+        let d = if scale > 0.0 { d / scale } else { d };
         match d.try_normalize(1e-12) {
             Some(d) => Some(d),
             None => {
@@ -273,11 +301,25 @@ impl Checker<'_> {
         match value {
             ast::Value::Rpy { angles, unit, .. } => {
                 let f = self.unit_factor(unit, Dimension::Angle)?;
-                Some(Rotation3::from_euler_angles(angles[0] * f, angles[1] * f, angles[2] * f))
+                let angles = angles.map(|a| a * f);
+                if let Some(message) =
+                    angles.iter().find_map(|a| beyond_bound(*a, Dimension::Angle))
+                {
+                    self.error(value.span(), message);
+                    return None;
+                }
+                Some(Rotation3::from_euler_angles(angles[0], angles[1], angles[2]))
             }
             ast::Value::Quat { wxyz, span } => {
-                let q = nalgebra::Quaternion::new(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
-                if !(q.norm() > 1e-9 && q.norm().is_finite()) {
+                let scale = wxyz.iter().fold(0.0, |m: Real, x| m.max(x.abs()));
+                if !scale.is_finite() {
+                    self.error(*span, "a quaternion's numbers must be finite");
+                    return None;
+                }
+                // Scaled first: the norm of numbers near the largest one would overflow.
+                let w = wxyz.map(|x| if scale > 0.0 { x / scale } else { x });
+                let q = nalgebra::Quaternion::new(w[0], w[1], w[2], w[3]);
+                if !(scale > 1e-300 && q.norm() > 1e-9) {
                     self.error(*span, "a quaternion must not be zero");
                     return None;
                 }
@@ -765,7 +807,7 @@ impl Checker<'_> {
             return None;
         }
         let duration = match &segment.duration {
-            Some(q) => Some(self.positive(q, Dimension::Time, "a segment's duration")?),
+            Some(q) => Some(self.duration(q, "a segment's duration")?),
             None => None,
         };
         Some(Segment { space, duration, primitives })
@@ -859,8 +901,7 @@ impl Checker<'_> {
                         goals.is_empty(),
                     );
                 }
-                let duration =
-                    durations.first().map(|d| self.positive(d, Dimension::Time, "the duration"));
+                let duration = durations.first().map(|d| self.duration(d, "the duration"));
                 ActionBody::Constraints {
                     goal: goal.flatten(),
                     path: path.flatten(),
@@ -984,6 +1025,7 @@ impl Checker<'_> {
                 ("rate", ast::SettingValue::Quantity(q)) => {
                     if let Some(v) = self.positive(q, Dimension::Frequency, "the rate") {
                         out.rate = v;
+                        self.rate_span = q.span;
                     }
                 }
                 ("solver", ast::SettingValue::Word(w)) => {
@@ -992,14 +1034,17 @@ impl Checker<'_> {
                     }
                 }
                 ("seed", ast::SettingValue::Quantity(q)) => {
-                    if q.unit.is_some()
-                        || q.value < 0.0
-                        || q.value.fract() != 0.0
-                        || q.value > 9.0e15
-                    {
-                        self.error(q.span, "the seed is a non-negative whole number");
-                    } else {
-                        out.seed = q.value as u64;
+                    // Read from the text: a number above 2^53 is not exact as a float.
+                    let written = self.source.get(q.span.start..q.span.end).unwrap_or("");
+                    let exact_float = q.value >= 0.0 && q.value.fract() == 0.0 && q.value < 9.0e15;
+                    match (q.unit.is_some(), written.parse::<u64>()) {
+                        (false, Ok(seed)) => out.seed = seed,
+                        // `7.0` or `1e3`: whole, and exact as a float.
+                        (false, Err(_)) if exact_float => out.seed = q.value as u64,
+                        _ => self.error(
+                            q.span,
+                            format!("the seed is a whole number from 0 to {}", u64::MAX),
+                        ),
                     }
                 }
                 ("transition", ast::SettingValue::Quantity(q)) => {
@@ -1083,6 +1128,29 @@ impl Checker<'_> {
         Some(resolved)
     }
 
+    /// The actions and their written segments against [`Limits::max_segments`] (each action
+    /// is at least one segment): an error at the action that crosses the limit.
+    fn segment_limit(&mut self, task: &ast::Task) {
+        let mut segments = 0usize;
+        for a in &task.actions {
+            segments = segments.saturating_add(match &a.body {
+                ast::ActionBody::Explicit { segments, .. } => segments.len().max(1),
+                _ => 1,
+            });
+            if segments > self.limits.max_segments {
+                self.error(
+                    a.name.span,
+                    format!(
+                        "the task has more than {} segments by this action (raise the limit \
+                         with --max-segments)",
+                        self.limits.max_segments
+                    ),
+                );
+                return;
+            }
+        }
+    }
+
     /// STRIPS: every fact an action needs or deletes, and every goal fact,
     /// is in `init` or added by some action.
     fn strips(&mut self, task: &ast::Task, init: &[String]) {
@@ -1113,10 +1181,36 @@ impl Checker<'_> {
     }
 }
 
+/// The workspace bound a value of `dimension` exceeds, as a message.
+fn beyond_bound(v: Real, dimension: Dimension) -> Option<String> {
+    match dimension {
+        Dimension::Length if v.abs() > MAX_LENGTH => {
+            Some(format!("{v:e} m is beyond the workspace bound of {MAX_LENGTH} m"))
+        }
+        Dimension::Angle if v.abs() > MAX_ANGLE => {
+            Some(format!("{v:e} rad is more than the bound of 100 turns"))
+        }
+        _ => None,
+    }
+}
+
 /// Validates a parsed file. `base_dir` is the task file's folder, against
 /// which the robot path is resolved.
-pub(super) fn validate(file: &ast::File, base_dir: Option<&Path>) -> Result<Task, Vec<Diagnostic>> {
-    let mut c = Checker { errors: Vec::new(), base_dir, obstacles: Vec::new() };
+pub(super) fn validate(
+    file: &ast::File,
+    source: &str,
+    base_dir: Option<&Path>,
+    limits: &Limits,
+) -> Result<Task, Vec<Diagnostic>> {
+    let mut c = Checker {
+        errors: Vec::new(),
+        base_dir,
+        source,
+        limits,
+        durations: Vec::new(),
+        rate_span: Span::default(),
+        obstacles: Vec::new(),
+    };
     let mut robot: Option<PathBuf> = None;
     let mut robot_chain: (Option<Name>, Option<Name>) = (None, None);
     let (mut seen_robot, mut start, mut scene, mut settings) = (false, None, Vec::new(), None);
@@ -1183,6 +1277,11 @@ pub(super) fn validate(file: &ast::File, base_dir: Option<&Path>) -> Result<Task
         }
     }
     let actions: Vec<Action> = task.actions.iter().filter_map(|a| c.action(a)).collect();
+    c.segment_limit(task);
+    let rate = settings.as_ref().map_or(Settings::default().rate, |s| s.rate);
+    if let Some(d) = bounds::check_samples(&c.durations, (c.rate_span, rate), c.limits) {
+        c.errors.push(d);
+    }
     let init = c.facts(&task.init, "init");
     let goal = c.facts(&task.goal, "goal");
     let planned = !task.init.is_empty() || !task.goal.is_empty();

@@ -71,7 +71,7 @@ fn a_failing_writer_keeps_the_previous_file() {
 }
 
 #[test]
-fn a_missing_folder_or_a_folder_as_target_is_an_io_error_without_leftovers() {
+fn a_missing_folder_is_an_io_error_and_a_folder_is_refused_without_leftovers() {
     let dir = scratch("io");
     let missing = dir.join("no/such/folder/out.mcap");
     let err = write_atomically(&missing, |_| Ok(())).expect_err("no folder");
@@ -79,7 +79,7 @@ fn a_missing_folder_or_a_folder_as_target_is_an_io_error_without_leftovers() {
     let folder = dir.join("sub");
     fs::create_dir(&folder).expect("created");
     let err = write_atomically(&folder, |out| Ok(out.write_all(b"x")?)).expect_err("a folder");
-    assert!(matches!(err, OutputError::Io { .. }));
+    assert!(matches!(err, OutputError::NotRegularFile { kind: "a folder", .. }), "{err}");
     assert_eq!(entries(&dir), ["sub"]);
     assert!(entries(&folder).is_empty());
     fs::remove_dir_all(dir).ok();
@@ -181,4 +181,39 @@ fn a_singular_state_is_null() {
         json,
         serde_json::json!({ "timestamp": { "sec": 0, "nsec": 0 }, "cpsa": null, "hat": null })
     );
+}
+
+#[cfg(unix)]
+#[test]
+fn special_files_and_links_are_refused_and_left_alone() {
+    let dir = scratch("special");
+    let kept = dir.join("kept.txt");
+    fs::write(&kept, "old").expect("written");
+    let link = dir.join("link.txt");
+    std::os::unix::fs::symlink(&kept, &link).expect("symlink");
+    let err = write_atomically(&link, |out| Ok(out.write_all(b"new")?)).expect_err("a link");
+    assert!(matches!(err, OutputError::NotRegularFile { kind: "a symbolic link", .. }), "{err}");
+    assert!(fs::symlink_metadata(&link).expect("link").file_type().is_symlink());
+    let device = std::path::Path::new("/dev/null");
+    let err = write_atomically(device, |out| Ok(out.write_all(b"new")?)).expect_err("a device");
+    assert!(matches!(err, OutputError::NotRegularFile { kind: "a device", .. }), "{err}");
+    assert_eq!(fs::read_to_string(&kept).expect("kept"), "old");
+    assert_eq!(entries(&dir), ["kept.txt", "link.txt"]);
+    fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn staged_files_are_removed_unless_committed() {
+    use super::Staged;
+    let dir = scratch("staged");
+    let (first, second) = (dir.join("a.txt"), dir.join("b.txt"));
+    fs::write(&first, "old a").expect("written");
+    let mut a = Staged::create(&first).expect("staged");
+    a.fill(|out| Ok(out.write_all(b"new a")?)).expect("filled");
+    let b = Staged::create(&second).expect("staged");
+    assert!(a.temporary().exists() && b.temporary().exists());
+    drop((a, b));
+    assert_eq!(entries(&dir), ["a.txt"], "no temporary left");
+    assert_eq!(fs::read_to_string(&first).expect("a"), "old a");
+    fs::remove_dir_all(dir).ok();
 }

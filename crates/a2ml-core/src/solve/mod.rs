@@ -10,6 +10,7 @@
 //! Their long loops report progress and check the user's wall-clock limit through a
 //! [`monitor::Monitor`]; without a limit, results never depend on the clock.
 
+mod checks;
 pub mod clik;
 pub mod compare;
 pub mod constrained_rrt;
@@ -24,6 +25,7 @@ pub mod qp;
 mod report;
 pub mod rrt;
 
+pub use checks::CheckError;
 pub use monitor::Monitor;
 pub use plan::{PlanOptions, Progress, SolveError, plan, plan_with_progress};
 pub use report::{Fallback, Plan, QpStats, SegmentReport, Tolerance, VariableError};

@@ -10,6 +10,7 @@
 
 use std::time::Instant;
 
+use super::checks::{self, CheckError};
 use super::constrained_rrt::{Chart, constrained_rrt_monitored, time_constrained};
 use super::control::{BaselineOptions, ControlError, ControlOptions, ControlRun};
 use super::map::{MapError, MapOptions, map_segment};
@@ -26,7 +27,9 @@ use crate::decompose::{
     decompose, goal_error,
 };
 use crate::kinematics::{HatState, arm_pose, hat_to_cpsa, ik_cpsa};
-use crate::language::{ActionBody, PrimitiveConstraint, SolverChoice, Space, Task, Variable};
+use crate::language::{
+    ActionBody, Limits, PrimitiveConstraint, SolverChoice, Space, Task, Variable,
+};
 use crate::math::{DOF, JointVector, Real, Vector3};
 use crate::metrics::smoothness::{normalised_jerk, speed_peaks};
 use crate::profile::{BodyFrames, ProfileError, Reference, Role, Sample};
@@ -57,6 +60,11 @@ pub struct PlanOptions {
     /// when it passes the plan fails with a `timeout`. Without it the outcome never depends
     /// on the machine's speed.
     pub time_limit: Option<Real>,
+    /// How large a motion may be planned (samples, segments).
+    pub limits: Limits,
+    /// A start (of the task or an action) closer to an obstacle than the safety distance is
+    /// a warning rather than an error.
+    pub allow_close_start: bool,
 }
 
 /// How far planning has got, for progress displays: `done` whole segments, then `fraction`
@@ -179,6 +187,9 @@ pub enum SolveError {
         /// Why.
         source: ControlError,
     },
+    /// The decomposed task is too large, or an action starts too close to an obstacle.
+    #[error(transparent)]
+    Check(#[from] CheckError),
     /// Joining or resampling the segments failed.
     #[error("joining the segments: {0}")]
     Trajectory(#[from] TrajectoryError),
@@ -220,6 +231,16 @@ pub fn plan_with_progress(
     let deadline = options.time_limit.and_then(deadline_after);
     let decomposition = decompose(robot, task, &options.decompose)?;
     let task_b = task.in_base_frame(&robot.structure.shoulder_in_base_link);
+    let close_starts = checks::before_solving(
+        robot,
+        &task_b,
+        &decomposition,
+        rate,
+        1.0 / options.qp.step,
+        options.qp.safety_distance,
+        &options.limits,
+        options.allow_close_start,
+    )?;
     let total = decomposition.actions.iter().map(|a| a.segments.len()).sum();
     let mut state = Solver {
         robot,
@@ -243,7 +264,8 @@ pub fn plan_with_progress(
     } else {
         state.finish()?
     };
-    let mut warnings = state.notes;
+    let mut warnings = close_starts;
+    warnings.extend(state.notes);
     warnings.append(&mut notes);
     if !task.scene.is_empty() {
         warnings.extend(robot.geometry_warnings.iter().map(|w| format!("collision geometry: {w}")));
@@ -254,6 +276,8 @@ pub fn plan_with_progress(
         wrist_reference.extend(piece.reference.iter().map(|(t, p)| (piece.start + t, *p)));
         segments.push(piece.report);
     }
+    let safety = options.qp.safety_distance;
+    warnings.extend(segments.iter().filter_map(|s| checks::too_close(s, safety)));
     warnings.extend(segments.iter().filter(|s| !s.reached).map(missed));
     warnings.extend(segments.iter().filter(|s| !s.path_kept).map(left_path));
     warnings.extend(segments.iter().filter(|s| !s.limits_kept).map(over_limits));
