@@ -421,6 +421,7 @@ mod tests {
             solver: None,
             rate: None,
             seed: None,
+            arm: crate::args::ArmArgs::default(),
         };
         assert_eq!(outputs(&args), vec![(Format::Mcap, PathBuf::from("lines.mcap"))]);
         let args = PlanArgs { csv: Some(PathBuf::from("x.csv")), ..args };
