@@ -188,7 +188,8 @@ fn reference_fk(
         };
         let [x, y, z] = numbers(attr("origin", "xyz"));
         let [r, p, w] = numbers(attr("origin", "rpy"));
-        pose *= Isometry::from_parts(Translation3::new(x, y, z), Rotation3::from_euler_angles(r, p, w));
+        pose *=
+            Isometry::from_parts(Translation3::new(x, y, z), Rotation3::from_euler_angles(r, p, w));
         if joint.attribute("type") != Some("fixed") {
             let axis = Vector3::from(numbers(attr("axis", "xyz").or(Some("1 0 0"))));
             let axis = nalgebra::Unit::new_normalize(axis);
@@ -223,9 +224,7 @@ fn third_party_forward_kinematics_matches_the_reference() {
             let ours = robot.b_from_base_link.inverse() * pose.frames[7] * tip.frame_from_link;
             let reference = reference_fk(&text, &robot.base_link, &robot.tip_link, &q);
             let dp = (ours.translation.vector - reference.translation.vector).norm();
-            let dr = (ours.rotation.matrix()
-                - reference.rotation.matrix())
-            .norm();
+            let dr = (ours.rotation.matrix() - reference.rotation.matrix()).norm();
             assert!(dp < 1e-12 && dr < 1e-12, "{name}: {dp:e} m, {dr:e} rad");
         }
     }
@@ -272,7 +271,10 @@ fn several_chains_list_their_base_and_tip_pairs() {
     assert!(err.contains("base `right_arm_mount` tip `right_wrist`"), "{err}");
     assert!(err.contains("base `left_arm_mount` tip `left_wrist`"), "{err}");
     let err = a2ml::Robot::from_urdf_file(urdf_data("tiago_pro.urdf")).unwrap_err().to_string();
-    assert!(err.contains("longest has 10") && err.contains("`torso_lift_link` tip `arm_left_7_link`"), "{err}");
+    assert!(
+        err.contains("longest has 10") && err.contains("`torso_lift_link` tip `arm_left_7_link`"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -282,19 +284,31 @@ fn continuous_joints_and_wide_ranges() {
         pr2.joints.iter().filter(|j| j.continuous).map(|j| j.name.as_str()).collect();
     assert_eq!(continuous, ["r_forearm_roll_joint", "r_wrist_roll_joint"]);
     for j in pr2.joints.iter().filter(|j| j.continuous) {
-        assert_eq!((j.limits.lower, j.limits.upper), (-2.0 * std::f64::consts::PI, 2.0 * std::f64::consts::PI));
+        assert_eq!(
+            (j.limits.lower, j.limits.upper),
+            (-2.0 * std::f64::consts::PI, 2.0 * std::f64::consts::PI)
+        );
     }
 }
 
 /// Distance from `p` to the segment a-b.
 fn segment_distance(p: &Vector3, a: &Vector3, b: &Vector3) -> f64 {
     let ab = b - a;
-    let t = if ab.norm_squared() > 0.0 { (ab.dot(&(p - a)) / ab.norm_squared()).clamp(0.0, 1.0) } else { 0.0 };
+    let t = if ab.norm_squared() > 0.0 {
+        (ab.dot(&(p - a)) / ab.norm_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     (p - (a + ab * t)).norm()
 }
 
 /// Clearance between the arm's capsules, placed by FK at `q`, and a ball.
-fn ball_clearance(robot: &a2ml::Robot, q: &a2ml::math::JointVector, centre: &Vector3, radius: f64) -> f64 {
+fn ball_clearance(
+    robot: &a2ml::Robot,
+    q: &a2ml::math::JointVector,
+    centre: &Vector3,
+    radius: f64,
+) -> f64 {
     let pose = a2ml::kinematics::arm_pose(robot, q);
     robot
         .capsules
@@ -369,7 +383,8 @@ fn third_party_reach_around_a_ball_keeps_its_clearance() {
             robot
         };
         let (text, centre, radius) = reach_around_ball(&robot, file, base, tip, 5);
-        let task = a2ml::language::parse(&text, None).unwrap_or_else(|d| panic!("{name}: {d}\n{text}"));
+        let task =
+            a2ml::language::parse(&text, None).unwrap_or_else(|d| panic!("{name}: {d}\n{text}"));
         assert_eq!((task.robot_base.as_deref(), task.robot_tip.as_deref()), (base, tip));
         let started = std::time::Instant::now();
         let plan = a2ml::solve::plan(&robot, &task, &a2ml::solve::PlanOptions::default())
@@ -385,7 +400,10 @@ fn third_party_reach_around_a_ball_keeps_its_clearance() {
             t += 1e-3;
         }
         let reached = plan.segments.iter().all(|s| s.reached);
-        println!("{name}: planned in {seconds:.3} s, clearance {:.1} mm, goal reached {reached}", worst * 1e3);
+        println!(
+            "{name}: planned in {seconds:.3} s, clearance {:.1} mm, goal reached {reached}",
+            worst * 1e3
+        );
         assert!(
             worst >= plan.safety_distance - 1e-4,
             "{name}: the arm comes within {worst} m of the ball (safety {})",
