@@ -155,7 +155,7 @@ fn third_party_round_trips(samples: usize) -> Vec<(&'static str, &'static str, R
             reached += usize::from(good && !solutions.is_empty());
             found += usize::from(contains(&solutions, &q));
         }
-        let kind = match (robot.has_analytic_ik(), robot.structure.idealisation > 1e-12) {
+        let kind = match (robot.has_analytic_ik(), robot.structure.idealisation > 1e-9) {
             (true, false) => "analytic",
             (true, true) => "analytic + Newton polish",
             (false, _) => "Newton from the spherical approximation",

@@ -48,7 +48,7 @@ pub struct ArmStructure {
     /// RMS distance of W from the axes it was fitted to (m).
     pub wrist_residual: Real,
     /// The largest distance (m) by which S misses axes 1-3 or W misses axes
-    /// 5-6 where the analytic IK takes them to meet; above 1e-12 its answers
+    /// 5-6 where the analytic IK takes them to meet; above 1e-9 its answers
     /// are polished by Newton on the real chain.
     pub idealisation: Real,
     /// Axis directions in {b} at zero configuration.
