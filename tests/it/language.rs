@@ -99,6 +99,7 @@ mod malformed {
     malformed!(start_wrong_count, 2, 7, "the start configuration needs 7 numbers, but 3 are given");
     malformed!(start_state_incomplete, 2, 7, "also needs Ow");
     malformed!(missing_robot_file, 1, 8, "robot file not found");
+    malformed!(robot_empty_tip, 1, 39, "a link name cannot be empty");
     malformed!(no_robot, 1, 1, "the file names no robot");
     malformed!(several_errors, 2, 12, "unknown setting `rat`");
     malformed!(unknown_unit_and_variable, 4, 18, "unknown unit `degs`");

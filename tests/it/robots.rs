@@ -188,7 +188,8 @@ fn reference_fk(
         };
         let [x, y, z] = numbers(attr("origin", "xyz"));
         let [r, p, w] = numbers(attr("origin", "rpy"));
-        pose *= Isometry::from_parts(Translation3::new(x, y, z), Rotation3::from_euler_angles(r, p, w));
+        pose *=
+            Isometry::from_parts(Translation3::new(x, y, z), Rotation3::from_euler_angles(r, p, w));
         if joint.attribute("type") != Some("fixed") {
             let axis = Vector3::from(numbers(attr("axis", "xyz").or(Some("1 0 0"))));
             let axis = nalgebra::Unit::new_normalize(axis);
@@ -223,9 +224,7 @@ fn third_party_forward_kinematics_matches_the_reference() {
             let ours = robot.b_from_base_link.inverse() * pose.frames[7] * tip.frame_from_link;
             let reference = reference_fk(&text, &robot.base_link, &robot.tip_link, &q);
             let dp = (ours.translation.vector - reference.translation.vector).norm();
-            let dr = (ours.rotation.matrix()
-                - reference.rotation.matrix())
-            .norm();
+            let dr = (ours.rotation.matrix() - reference.rotation.matrix()).norm();
             assert!(dp < 1e-12 && dr < 1e-12, "{name}: {dp:e} m, {dr:e} rad");
         }
     }
@@ -272,7 +271,10 @@ fn several_chains_list_their_base_and_tip_pairs() {
     assert!(err.contains("base `right_arm_mount` tip `right_wrist`"), "{err}");
     assert!(err.contains("base `left_arm_mount` tip `left_wrist`"), "{err}");
     let err = a2ml::Robot::from_urdf_file(urdf_data("tiago_pro.urdf")).unwrap_err().to_string();
-    assert!(err.contains("longest has 10") && err.contains("`torso_lift_link` tip `arm_left_7_link`"), "{err}");
+    assert!(
+        err.contains("longest has 10") && err.contains("`torso_lift_link` tip `arm_left_7_link`"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -282,6 +284,156 @@ fn continuous_joints_and_wide_ranges() {
         pr2.joints.iter().filter(|j| j.continuous).map(|j| j.name.as_str()).collect();
     assert_eq!(continuous, ["r_forearm_roll_joint", "r_wrist_roll_joint"]);
     for j in pr2.joints.iter().filter(|j| j.continuous) {
-        assert_eq!((j.limits.lower, j.limits.upper), (-2.0 * std::f64::consts::PI, 2.0 * std::f64::consts::PI));
+        assert_eq!(
+            (j.limits.lower, j.limits.upper),
+            (-2.0 * std::f64::consts::PI, 2.0 * std::f64::consts::PI)
+        );
     }
+}
+
+/// Distance from `p` to the segment a-b.
+fn segment_distance(p: &Vector3, a: &Vector3, b: &Vector3) -> f64 {
+    let ab = b - a;
+    let t = if ab.norm_squared() > 0.0 {
+        (ab.dot(&(p - a)) / ab.norm_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + ab * t)).norm()
+}
+
+/// Clearance between the arm's capsules, placed by FK at `q`, and a ball.
+fn ball_clearance(
+    robot: &a2ml::Robot,
+    q: &a2ml::math::JointVector,
+    centre: &Vector3,
+    radius: f64,
+) -> f64 {
+    let pose = a2ml::kinematics::arm_pose(robot, q);
+    robot
+        .capsules
+        .iter()
+        .map(|c| {
+            let frame = pose.frames[c.frame];
+            let a = frame.transform_point(&c.a.into()).coords;
+            let b = frame.transform_point(&c.b.into()).coords;
+            segment_distance(centre, &a, &b) - c.radius - radius
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// A reach from one in-limit configuration to the CPSA state of another,
+/// with a 4 cm ball on the way: the task text, the ball's centre and radius.
+fn reach_around_ball(
+    robot: &a2ml::Robot,
+    file: &str,
+    base: Option<&str>,
+    tip: Option<&str>,
+    seed: u64,
+) -> (String, Vector3, f64) {
+    // A 4 cm ball on an adult-sized arm, scaled down on a child-sized one (iCub).
+    let reach = robot.upper_arm_length() + robot.forearm_length();
+    let radius = 0.04_f64.min(0.05 * reach);
+    let mut rng = crate::common::rng(seed);
+    for _ in 0..100_000 {
+        let (q0, p0) = crate::common::regular_q(robot, &mut rng, 0.2);
+        let (q1, p1) = crate::common::regular_q(robot, &mut rng, 0.2);
+        let distance = (p1.wrist - p0.wrist).norm();
+        let centre = 0.5 * (p0.wrist + p1.wrist);
+        if !(0.25 * reach..0.6 * reach).contains(&distance)
+            || ball_clearance(robot, &q0, &centre, radius) < 0.03_f64.min(0.06 * reach)
+            || ball_clearance(robot, &q1, &centre, radius) < 0.03_f64.min(0.06 * reach)
+        {
+            continue;
+        }
+        let goal = a2ml::kinematics::cpsa_state(robot, &p1).expect("regular");
+        let quat = a2ml::math::UnitQuaternion::from_rotation_matrix(&goal.ow);
+        let mut line = format!("robot \"{}\"", urdf_data(file).display());
+        if let Some(b) = base {
+            line += &format!(" base \"{b}\"");
+        }
+        if let Some(t) = tip {
+            line += &format!(" tip \"{t}\"");
+        }
+        let v = |x: &[f64]| x.iter().map(|v| format!("{v:.12}")).collect::<Vec<_>>().join(", ");
+        let text = format!(
+            "{line}\nstart [{}] rad\nscene {{ ball = sphere at [{}] radius {radius} }}\n\
+             task reach {{ action a {{ goal Pw Ow θsw = ([{}], quat({}), {:.12} rad) }} }}\n",
+            v(q0.as_slice()),
+            v(centre.as_slice()),
+            v(goal.pw.as_slice()),
+            v(&[quat.w, quat.i, quat.j, quat.k]),
+            goal.swivel,
+        );
+        return (text, centre, radius);
+    }
+    panic!("no reach with a ball between its ends found for {}", robot.name);
+}
+
+#[test]
+fn third_party_reach_around_a_ball_keeps_its_clearance() {
+    for ((name, robot), (_, file, base, tip)) in third_party().into_iter().zip(THIRD_PARTY) {
+        // iCub's meshes are not vendored, and the default skeleton radius
+        // (6 cm) is an adult's: a child-sized arm gets one of its own.
+        let robot = if name == "icub" {
+            let mut options = third_party_options(base, tip);
+            options.geometry.skeleton_radius = Some(0.025);
+            a2ml::Robot::from_urdf_file_with(urdf_data(file), &options).expect("icub")
+        } else {
+            robot
+        };
+        let (text, centre, radius) = reach_around_ball(&robot, file, base, tip, 5);
+        let task =
+            a2ml::language::parse(&text, None).unwrap_or_else(|d| panic!("{name}: {d}\n{text}"));
+        assert_eq!((task.robot_base.as_deref(), task.robot_tip.as_deref()), (base, tip));
+        let started = std::time::Instant::now();
+        let plan = a2ml::solve::plan(&robot, &task, &a2ml::solve::PlanOptions::default())
+            .unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
+        let seconds = started.elapsed().as_secs_f64();
+        let trajectory = &plan.trajectory;
+        let mut worst = f64::INFINITY;
+        let mut t = trajectory.start();
+        while t <= trajectory.end() {
+            let q = trajectory.sample(t).0;
+            assert!(robot.within_limits(&q, 1e-6), "{name}: limits at t = {t}");
+            worst = worst.min(ball_clearance(&robot, &q, &centre, radius));
+            t += 1e-3;
+        }
+        let reached = plan.segments.iter().all(|s| s.reached);
+        println!(
+            "{name}: planned in {seconds:.3} s, clearance {:.1} mm, goal reached {reached}",
+            worst * 1e3
+        );
+        assert!(
+            worst >= plan.safety_distance - 1e-4,
+            "{name}: the arm comes within {worst} m of the ball (safety {})",
+            plan.safety_distance
+        );
+    }
+}
+
+#[test]
+fn an_arm_without_geometry_is_covered_by_its_skeleton_or_refused() {
+    // xArm7's meshes are not vendored: its collision geometry is the skeleton,
+    // and a task with an obstacle says so.
+    let (_, file, base, tip) = THIRD_PARTY[1];
+    let xarm = a2ml::Robot::from_urdf_file(urdf_data(file)).expect("xarm");
+    assert!(xarm.capsules.iter().all(|c| c.source == a2ml::robot::CapsuleSource::Skeleton));
+    let (text, centre, radius) = reach_around_ball(&xarm, file, base, tip, 9);
+    let task = a2ml::language::parse(&text, None).expect("task");
+    let plan = a2ml::solve::plan(&xarm, &task, &a2ml::solve::PlanOptions::default()).expect("plan");
+    assert!(plan.warnings.iter().any(|w| w.contains("skeleton capsule")), "{:?}", plan.warnings);
+    let mut t = plan.trajectory.start();
+    while t <= plan.trajectory.end() {
+        let q = plan.trajectory.sample(t).0;
+        assert!(ball_clearance(&xarm, &q, &centre, radius) >= plan.safety_distance - 1e-4);
+        t += 1e-3;
+    }
+    // Skeleton off: nothing to check obstacles against, so planning refuses.
+    let mut options = a2ml::RobotOptions::default();
+    options.geometry.skeleton_radius = None;
+    let bare = a2ml::Robot::from_urdf_file_with(urdf_data(file), &options).expect("xarm");
+    assert!(bare.capsules.is_empty() && !bare.has_arm_geometry());
+    let err = a2ml::solve::plan(&bare, &task, &a2ml::solve::PlanOptions::default()).unwrap_err();
+    assert!(matches!(err, a2ml::solve::SolveError::NoArmGeometry { .. }), "{err:?}");
 }

@@ -10,10 +10,10 @@ use std::path::PathBuf;
 use clap::Args;
 use serde::Serialize;
 
+use a2ml_core::Robot;
 use a2ml_core::kinematics::{self, KinematicsError};
 use a2ml_core::math::{DOF, JointVector, Real, Rotation3, Vector3};
 use a2ml_core::robot::{Capsule, CapsuleSource, LinkRole};
-use a2ml_core::Robot;
 
 use crate::error::CliError;
 use crate::output::{

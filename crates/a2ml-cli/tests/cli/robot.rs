@@ -103,8 +103,9 @@ fn json_has_the_documented_keys() {
     assert_eq!(s["is_srs"], true);
     assert_eq!(s["has_analytic_ik"], true);
     let capsule = &json["capsules"][0];
-    assert_eq!(keys(capsule), sorted(vec!["name", "link", "role", "radius", "length"]));
+    assert_eq!(keys(capsule), sorted(vec!["name", "link", "role", "radius", "length", "source"]));
     assert_eq!(capsule["role"], "upper_arm");
+    assert_eq!(capsule["source"], "shape");
 }
 
 #[test]

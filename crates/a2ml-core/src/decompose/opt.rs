@@ -57,7 +57,13 @@ impl ArmState {
         match (space, values) {
             (Space::Cpsa, [Target::Position(pw), Target::Rotation(ow), Target::Angle(swivel)]) => {
                 let cpsa = CpsaState { pw: *pw, ow: *ow, swivel: wrap_angle(*swivel) };
-                Some(Self { hat: cpsa_to_hat(robot, &cpsa).ok()?, cpsa })
+                // Beyond the annulus of lu and lf an arm with offsets may still reach:
+                // its HAT state is then the real chain's, from IK.
+                let hat = cpsa_to_hat(robot, &cpsa).ok().or_else(|| {
+                    let q = *crate::kinematics::ik_cpsa(robot, &cpsa, None).ok()?.first()?;
+                    crate::kinematics::hat_state(&crate::kinematics::arm_pose(robot, &q)).ok()
+                })?;
+                Some(Self { hat, cpsa })
             }
             (Space::Hat, [Target::Rotation(os), Target::Angle(elbow), Target::Rotation(ow)]) => {
                 if !(0.0..=PI).contains(elbow) {

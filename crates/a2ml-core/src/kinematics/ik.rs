@@ -188,7 +188,7 @@ where
     F: Fn(&JointVector) -> Result<(Vector7, Matrix7), KinematicsError>,
 {
     let inside = select(robot, branches, near, options.limit_tolerance)?;
-    if robot.structure.idealisation <= 1e-12 {
+    if robot.structure.idealisation <= 1e-9 {
         return Ok(inside);
     }
     let mut budget = Budget::new(options);

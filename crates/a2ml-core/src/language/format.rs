@@ -1175,7 +1175,9 @@ task t {
         let comments: Vec<(&str, bool)> =
             tree.comments.iter().map(|c| (c.text.as_str(), c.own_line)).collect();
         assert_eq!(comments, [("#a // b", false), ("//c # d", true)]);
-        let Item::Robot(super::super::ast::RobotLine { path, .. }) = &tree.items[0] else { panic!("robot") };
+        let Item::Robot(super::super::ast::RobotLine { path, .. }) = &tree.items[0] else {
+            panic!("robot")
+        };
         assert_eq!(path.text, "a#b//c.urdf");
         assert_eq!(
             canonical(text),

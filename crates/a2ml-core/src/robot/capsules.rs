@@ -169,7 +169,8 @@ pub(super) fn build(
         warnings.push(format!("link `{}`: {}", m.link, m.why));
     }
     for &(role, frame, a, b) in &skeleton.parts {
-        let covered = capsules.iter().any(|c| c.role == role && c.source != CapsuleSource::Skeleton);
+        let covered =
+            capsules.iter().any(|c| c.role == role && c.source != CapsuleSource::Skeleton);
         let gap = missing.iter().any(|m| m.role == role);
         if covered && !gap {
             continue;

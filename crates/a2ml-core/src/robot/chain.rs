@@ -305,7 +305,11 @@ pub(super) fn build(
                 });
             }
         }
-        links.push(ChainLink { name: joint.child.clone(), frame: joints.len(), frame_from_link: acc });
+        links.push(ChainLink {
+            name: joint.child.clone(),
+            frame: joints.len(),
+            frame_from_link: acc,
+        });
     }
     let tip = links.last().map(|l| l.name.clone()).unwrap_or_else(|| base.clone());
     let frame7_from_hand = acc.rotation * tool;

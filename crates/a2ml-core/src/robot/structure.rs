@@ -48,7 +48,7 @@ pub struct ArmStructure {
     /// RMS distance of W from the axes it was fitted to (m).
     pub wrist_residual: Real,
     /// The largest distance (m) by which S misses axes 1-3 or W misses axes
-    /// 5-6 where the analytic IK takes them to meet; above 1e-12 its answers
+    /// 5-6 where the analytic IK takes them to meet; above 1e-9 its answers
     /// are polished by Newton on the real chain.
     pub idealisation: Real,
     /// Axis directions in {b} at zero configuration.
@@ -141,7 +141,8 @@ pub(crate) fn analyse(
             "degenerate limb lengths (upper arm {upper_arm_length:.6} m, forearm {forearm_length:.6} m)"
         ));
     }
-    let (short, long) = (upper_arm_length.min(forearm_length), upper_arm_length.max(forearm_length));
+    let (short, long) =
+        (upper_arm_length.min(forearm_length), upper_arm_length.max(forearm_length));
     if short < SHORTEST_LIMB_RELATIVE * long {
         return Err(format!(
             "a segment far too short (upper arm {upper_arm_length:.4} m, forearm \
@@ -164,8 +165,10 @@ pub(crate) fn analyse(
         line_distance(&points[2], &axes[2], &points[3], &axes[3]),
         line_distance(&points[3], &axes[3], &points[4], &axes[4]),
     ];
-    let wrist_miss =
-        [4, 5].iter().map(|&i| projector(&axes[i]).mul(&(wrist - points[i])).norm()).fold(0.0, Real::max);
+    let wrist_miss = [4, 5]
+        .iter()
+        .map(|&i| projector(&axes[i]).mul(&(wrist - points[i])).norm())
+        .fold(0.0, Real::max);
     let wrist_decoupled = wrist_miss < tol;
     let idealisation = shoulder_residual.max(wrist_miss);
     let is_srs = shoulder_spherical && wrist_spherical && elbow_offsets.iter().all(|o| *o < tol);

@@ -472,7 +472,8 @@ mod tests {
 
     #[test]
     fn bad_shapes_are_refused() {
-        let text = arm("").replace(r#"<box size="1 2 3"/>"#, r#"<cylinder radius="-1" length="1"/>"#);
+        let text =
+            arm("").replace(r#"<box size="1 2 3"/>"#, r#"<cylinder radius="-1" length="1"/>"#);
         assert!(message(&text).contains("`radius` is negative"));
         let text = arm("").replace(r#"<box size="1 2 3"/>"#, r#"<sphere radius="nan"/>"#);
         assert!(message(&text).contains("not a finite number"));
