@@ -6,6 +6,7 @@ use clap::{Parser, Subcommand};
 use crate::commands::check::CheckArgs;
 use crate::commands::explain::ExplainArgs;
 use crate::commands::fmt::FmtArgs;
+use crate::commands::map::MapArgs;
 use crate::commands::plan::PlanArgs;
 use crate::commands::robot::RobotArgs;
 
@@ -21,6 +22,7 @@ Examples:
   a2ml fmt --write task.a2ml
   a2ml explain examples/type_iv_forward_bar.a2ml
   a2ml plan examples/construct_path_line.a2ml -o lines.mcap
+  a2ml map examples/swivel_map_spheres.a2ml --action pass_spheres -o map.svg
 
 Exit codes: 0 success, 1 I/O error, 2 invalid input, 3 a goal missed (plan
 written), 4 planning failed.")]
@@ -43,4 +45,6 @@ pub enum Commands {
     Explain(ExplainArgs),
     /// Plan a task's motion and write it as MCAP (for Foxglove), CSV or JSON.
     Plan(PlanArgs),
+    /// Draw the time × swivel obstacle map of one segment, and its profile, as SVG.
+    Map(MapArgs),
 }

@@ -5,6 +5,7 @@
 pub mod check;
 pub mod explain;
 pub mod fmt;
+pub mod map;
 pub mod plan;
 pub mod robot;
 
@@ -27,6 +28,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Commands::Fmt(args) => fmt::run(&args),
         Commands::Explain(args) => explain::run(&args),
         Commands::Plan(args) => plan::run(&args),
+        Commands::Map(args) => map::run(&args),
     }
 }
 
