@@ -420,7 +420,11 @@ fn map_solver_plans_the_example_task() {
         a2ml::solve::plan(&robot, &task, &a2ml::solve::PlanOptions::default()).expect("plan");
     let segment = &plan.segments[0];
     assert_eq!(segment.solver, a2ml::language::SolverChoice::Map);
-    assert!(segment.reached, "{:?}", segment.errors);
+    // Pw and Ow reach their goal and hold exactly; θsw, which the map releases from its
+    // hold, ends away from its start and the report says so (not reached).
+    let [pw, ow, swivel] = [&segment.errors[0], &segment.errors[1], &segment.errors[2]];
+    assert!(pw.within && ow.within, "{:?}", segment.errors);
+    assert!(!swivel.within && !segment.reached && !plan.warnings.is_empty());
     let clearance = segment.clearance.as_ref().expect("pairs");
     assert!(clearance.distance >= 0.0, "{clearance:?}");
     assert!(segment.limit_margin >= 0.0);

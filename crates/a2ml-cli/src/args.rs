@@ -8,6 +8,7 @@ use crate::commands::check::CheckArgs;
 use crate::commands::compare::CompareArgs;
 use crate::commands::explain::ExplainArgs;
 use crate::commands::fmt::FmtArgs;
+use crate::commands::map::MapArgs;
 use crate::commands::plan::PlanArgs;
 use crate::commands::plot::PlotArgs;
 use crate::commands::report::ReportArgs;
@@ -29,6 +30,7 @@ Examples:
   a2ml plot examples/type_iv_forward_bar.a2ml -o forward_bar.svg
   a2ml report examples/push_box_aside_coman.a2ml -o push_box.html
   a2ml compare examples/baseline_pmp.a2ml --solvers qp,pmp
+  a2ml map examples/swivel_map_spheres.a2ml --action pass_spheres -o map.svg
 
 Exit codes: 0 success, 1 I/O error, 2 invalid input, 3 a goal missed (plan
 written), 4 planning failed.")]
@@ -59,6 +61,8 @@ pub enum Commands {
     Report(ReportArgs),
     /// Plan one task with several solvers (the baselines among them) and compare the results.
     Compare(CompareArgs),
+    /// Draw the time × swivel obstacle map of one segment, and its profile, as SVG.
+    Map(MapArgs),
 }
 
 /// How `robot`, `explain` and `plan` read the arm from its URDF.

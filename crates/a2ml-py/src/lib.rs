@@ -9,6 +9,7 @@
 mod decompose;
 mod language;
 mod compare;
+mod map;
 mod plan;
 
 use std::path::{Path, PathBuf};
@@ -579,6 +580,7 @@ fn _a2ml(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<plan::PySegmentReport>()?;
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     m.add_function(wrap_pyfunction!(compare::compare, m)?)?;
+    m.add_function(wrap_pyfunction!(map::swivel_map, m)?)?;
     m.add("A2mlError", py.get_type::<A2mlError>())?;
     m.add("UrdfError", py.get_type::<UrdfError>())?;
     m.add("ParseError", py.get_type::<ParseError>())?;

@@ -7,6 +7,7 @@ pub mod check;
 pub mod compare;
 pub mod explain;
 pub mod fmt;
+pub mod map;
 pub mod plan;
 pub mod plot;
 pub mod report;
@@ -38,6 +39,7 @@ pub fn run(cli: Cli, temporaries: &Temporaries) -> Result<(), CliError> {
         Commands::Plot(args) => plot::run(&args),
         Commands::Report(args) => report::run(&args),
         Commands::Compare(args) => compare::run(&args),
+        Commands::Map(args) => map::run(&args),
     }
 }
 

@@ -15,6 +15,8 @@ shoulder centre. Arrays are float64 numpy arrays.
 >>> plan = a2ml.plan("push.a2ml")  # doctest: +SKIP
 >>> plan.t.shape, plan.q.shape, plan.reached  # doctest: +SKIP
 >>> plan.write_mcap("push.mcap")  # doctest: +SKIP
+>>> m = a2ml.swivel_map("push.a2ml", action="push_a")  # doctest: +SKIP
+>>> m["labels"].shape, m["profile"]["q"].shape  # doctest: +SKIP
 
 Invalid task text raises :class:`ParseError`, located by ``line`` and
 ``column`` and rendered in full by ``str()``; a task that cannot be
@@ -45,6 +47,7 @@ from a2ml._a2ml import (
     load,
     parse,
     plan,
+    swivel_map,
 )
 from a2ml._types import (
     Clearance,
@@ -85,4 +88,5 @@ __all__ = [
     "load",
     "parse",
     "plan",
+    "swivel_map",
 ]

@@ -657,7 +657,7 @@ def plan(
 
     ``task_or_path`` is a :class:`Task` or the path of a task file (read as
     :func:`load` does). ``solver`` overrides the solver of the task and of
-    every action (default: theirs; ``"map"`` is not available yet; ``"gpm"``,
+    every action (default: theirs; ``"map"`` is the swivel obstacle map; ``"gpm"``,
     ``"clik"`` and ``"pmp"`` are the baselines). ``rate`` (Hz) overrides the task's
     ``settings { rate }`` (default 100 Hz); ``seed`` its ``seed``. ``robot``
     defaults to the task's robot file (:attr:`Task.robot`).
@@ -701,3 +701,42 @@ def compare(
         FileNotFoundError, OSError, ParseError: as :func:`load`.
         UrdfError: the task's robot file cannot be loaded as a 7-DoF arm.
     """
+
+
+def swivel_map(
+    task_or_robot: Task | Robot | str | os.PathLike[str],
+    action: str | None = None,
+    segment: int = 1,
+    *,
+    start: ArrayLike | None = None,
+    points: ArrayLike | None = None,
+    duration: float | None = None,
+    spheres: list[tuple[str, list[float], float]] | None = None,
+    time_steps: int = 200,
+    angle_steps: int = 360,
+    safety_distance: float = 0.01,
+) -> dict[str, Any]:
+    """The time × swivel obstacle map (METHODS.md §1) and its planned profile.
+
+    For a task (a :class:`Task` or a path): segment ``segment`` (from 1) of
+    ``action``, from the decomposition's start of that segment. For a
+    :class:`Robot`: the wrist path from ``start``'s wrist through ``points``
+    ((K, 3), m in {b}) as a clamped cubic spline with chord-length knots over
+    ``duration`` s, the hand orientation held, among ``spheres``
+    (``(name, [x, y, z], radius)``, m).
+
+    Returns a dict: ``t`` (N_t,) s; ``swivel`` (N_θ,) cell-centre angles in
+    rad over [-π, π); ``labels`` (N_t, N_θ) int8 (0 free, 1 joint limits,
+    2 self-collision, 3 + k obstacle k); ``obstacles`` (names); ``faults``
+    (per column None, or why the wrist pose rules it out); ``profile`` (None,
+    or a dict of ``t``, ``swivel``, ``q`` (N, 7), ``qd`` (N, 7) at 1 kHz and
+    ``clearance`` in m); ``error`` (None, or why there is no profile, naming
+    the time the free region is cut). Releases the GIL.
+
+    Raises:
+        TypeError: ``task_or_robot`` or ``points`` has the wrong type.
+        ValueError: a missing or invalid argument, an unknown action or
+            segment, a task that does not decompose, a HAT segment or an arm
+            without analytic IK.
+    """
+

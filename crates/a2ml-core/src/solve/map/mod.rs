@@ -100,6 +100,19 @@ pub enum MapError {
     /// The start configuration's swivel angle is not usable.
     #[error("the start configuration: {0}")]
     Start(KinematicsError),
+    /// The start configuration is already too close to an obstacle or itself.
+    #[error(
+        "the start configuration is {:.1} mm from the nearest obstacle or self-collision pair, \
+         closer than the safety distance {:.1} mm",
+        clearance * 1e3,
+        safety * 1e3
+    )]
+    StartBlocked {
+        /// Its clearance (m).
+        clearance: Real,
+        /// The safety distance (m).
+        safety: Real,
+    },
     /// Even the least smoothed profile fails the fine check.
     #[error("the swivel profile fails its check at t = {time:.4} s: {why}")]
     Verification {

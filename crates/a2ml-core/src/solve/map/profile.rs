@@ -47,7 +47,8 @@ struct GridPath {
 /// [`MapError::PathInfeasible`] naming the first column the wrist pose rules out;
 /// [`MapError::NoProfile`] naming the first time the free region is cut;
 /// [`MapError::Verification`] when even the spline through every node fails the fine check;
-/// [`MapError::Start`] when the start's swivel angle is undefined.
+/// [`MapError::Start`] when the start's swivel angle is undefined;
+/// [`MapError::StartBlocked`] when the start is already closer than the safety distance.
 pub fn plan_profile(
     robot: &Robot,
     obstacles: &[Obstacle],
@@ -70,9 +71,13 @@ pub fn plan_profile(
     }
     let pose = arm_pose(robot, start);
     let start_swivel = crate::kinematics::cpsa_state(robot, &pose).map_err(MapError::Start)?.swivel;
+    let model = CollisionModel::new(robot, &CollisionScene::new(obstacles));
+    let at_start = clearance(&model, start);
+    if at_start < options.safety_distance {
+        return Err(MapError::StartBlocked { clearance: at_start, safety: options.safety_distance });
+    }
     let path = search(map, start_swivel, targets, options)?;
     let duration = map.times.last().copied().unwrap_or(0.0);
-    let model = CollisionModel::new(robot, &CollisionScene::new(obstacles));
     let nodes: Vec<(Real, Real)> = path.nodes.iter().map(|&(i, a)| (map.times[i], a)).collect();
     let mut failure = None;
     for smoothing in [8, 4, 2, 1] {
