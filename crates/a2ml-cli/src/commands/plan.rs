@@ -212,6 +212,7 @@ fn solve_error(file: &Path, error: SolveError) -> CliError {
         SolveError::Reference { .. }
         | SolveError::Qp { .. }
         | SolveError::Rrt { .. }
+        | SolveError::Hamp { .. }
         | SolveError::Trajectory(_) => CliError::Planning(message),
     }
 }

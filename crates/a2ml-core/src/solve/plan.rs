@@ -2,6 +2,7 @@
 //! segments (+Tr within an action, +Se between actions) and report on each.
 
 use super::constrained_rrt::{Chart, constrained_rrt, time_constrained};
+use super::hamp::{HampOptions, HandoverTarget, plan_handover};
 use super::qp::{self, Component, QpError, QpOptions, SegmentProblem};
 use super::report::{Fallback, Plan, QpStats, SegmentReport, VariableError};
 use super::rrt::{RrtError, RrtOptions, RrtStats, TimedPath, rrt_connect, time_parameterise};
@@ -99,6 +100,16 @@ pub enum SolveError {
         segment: usize,
         /// Why.
         source: QpError,
+    },
+    /// The HAMP planner failed on a segment.
+    #[error("action `{action}`, segment {}: hamp: {source}", segment + 1)]
+    Hamp {
+        /// The action.
+        action: String,
+        /// Segment index (0-based).
+        segment: usize,
+        /// Why.
+        source: super::hamp::HampError,
     },
     /// Joining or resampling the segments failed.
     #[error("joining the segments: {0}")]
@@ -327,6 +338,7 @@ impl Solver<'_> {
             SolverChoice::Auto => self.qp(job),
             SolverChoice::Rrt if pattern == SegmentPattern::Goal => self.rrt(job),
             SolverChoice::Rrt => self.constrained(job),
+            SolverChoice::Hamp if pattern == SegmentPattern::Goal => self.hamp(job),
             solver => Err(SolveError::UnsupportedSolver {
                 action: job.action.name.clone(),
                 solver,
@@ -386,6 +398,28 @@ impl Solver<'_> {
         let timed = time_constrained(self.robot, &job.chart, &path, job.segment.duration, rate)
             .map_err(|e| job.rrt_failed(e))?;
         Ok(self.timed(job, timed, path.stats))
+    }
+
+    /// A goal segment by the HAMP handover planner towards its end state: the pick-up
+    /// patterns, timed by Fitts' law (METHODS.md §3.4).
+    fn hamp(&mut self, job: &Job) -> Result<Solved, SolveError> {
+        let failed = |source| SolveError::Hamp { action: job.action.name.clone(), segment: job.k, source };
+        let goal = ArmState::at(self.robot, &job.segment.end)
+            .map_err(|e| failed(super::hamp::HampError::Target(e)))?;
+        let target =
+            HandoverTarget { pw: goal.cpsa.pw, ow: goal.cpsa.ow, swivel: Some(goal.cpsa.swivel) };
+        let options = HampOptions {
+            seed: self.task.settings.seed,
+            rate: 1.0 / self.options.qp.step,
+            ..HampOptions::default()
+        };
+        let planned = plan_handover(self.robot, &self.q, &target, job.scene, &options).map_err(failed)?;
+        if !planned.limit_violations.is_empty() {
+            self.notes.push(format!("{}: the hamp motion exceeds a joint speed limit", job.name()));
+        }
+        let duration = planned.duration;
+        let timed = TimedPath { trajectory: planned.trajectory, duration, stretched: false };
+        Ok(Solved { solver: SolverChoice::Hamp, rrt: None, ..self.timed(job, timed, RrtStats::default()) })
     }
 
     fn rrt_options(&self) -> RrtOptions {
