@@ -101,6 +101,25 @@ fn quat(r: &Rotation3) -> String {
     format!("quat({}, {}, {}, {})", q.w, q.i, q.j, q.k)
 }
 
+/// The handover of [`target`] from COMAN's start as a task with one goal action, solved by
+/// `solver` (the task's default when `None`).
+fn handover_task(robot: &Robot, solver: Option<&str>) -> a2ml::language::Task {
+    let start = coman_start();
+    let goal = target(robot, &start);
+    let q = start.iter().map(|v| format!("{v}")).collect::<Vec<_>>().join(", ");
+    let solver = solver.map_or(String::new(), |s| format!("    solver {s}\n"));
+    let source = format!(
+        "robot \"../robots/coman_right_arm.urdf\"\nstart [{q}] rad\nsettings {{ rate 120 Hz }}\ntask \
+         handover {{\n  action pick_up {{\n    goal Pw Ow θsw = ([{}, {}, {}], {}, {})\n{solver}  }}\n}}\n",
+        goal.pw.x,
+        goal.pw.y,
+        goal.pw.z,
+        quat(&goal.ow),
+        goal.swivel.expect("given")
+    );
+    language::parse(&source, Some(&common::example("inline.a2ml"))).unwrap_or_else(|d| panic!("{d}"))
+}
+
 fn row(name: &str, a: &Analysis) -> String {
     let w = &a.whole;
     let rula = w.rula.expect("scored");
@@ -125,20 +144,7 @@ fn row(name: &str, a: &Analysis) -> String {
 #[test]
 fn hamp_and_a2ml_plans_of_one_handover_scored_side_by_side() {
     let (robot, hamp) = hamp_plan(Handover::PickUp);
-    let start = coman_start();
-    let goal = target(&robot, &start);
-    let q = start.iter().map(|v| format!("{v}")).collect::<Vec<_>>().join(", ");
-    let source = format!(
-        "robot \"../robots/coman_right_arm.urdf\"\nstart [{q}] rad\ntask handover {{\n  action \
-         pick_up {{\n    goal Pw Ow θsw = ([{}, {}, {}], {}, {})\n  }}\n}}\n",
-        goal.pw.x,
-        goal.pw.y,
-        goal.pw.z,
-        quat(&goal.ow),
-        goal.swivel.expect("given")
-    );
-    let task = language::parse(&source, Some(&common::example("inline.a2ml")))
-        .unwrap_or_else(|d| panic!("{d}"));
+    let task = handover_task(&robot, None);
     let a2ml = plan(&robot, &task, &PlanOptions::default()).expect("plans");
     assert!(a2ml.reached(), "{:?}", a2ml.warnings);
 
@@ -163,4 +169,25 @@ fn hamp_and_a2ml_plans_of_one_handover_scored_side_by_side() {
     // stretched only for the joint speed limits, and settles after it.
     assert!((of_hamp.whole.fitts.ratio - 1.0).abs() < 1e-9);
     assert!(of_a2ml.whole.fitts.ratio >= 1.0 - 1e-9);
+}
+
+/// `solver hamp` on a goal action: the plan's segment is solved by the HAMP planner, reaches
+/// the goal, lasts Fitts' T and shows the pick-up patterns.
+#[test]
+fn solver_hamp_plans_a_goal_action_as_a_pick_up() {
+    let robot = common::load("coman_right_arm");
+    let start = coman_start();
+    let goal = target(&robot, &start);
+    let task = handover_task(&robot, Some("hamp"));
+    let planned = plan(&robot, &task, &PlanOptions::default()).expect("plans");
+    assert!(planned.reached(), "{:?}", planned.warnings);
+    let segment = &planned.segments[0];
+    assert_eq!(segment.solver.name(), "hamp");
+    let travel = (goal.pw - cpsa_state(&robot, &arm_pose(&robot, &start)).expect("regular").pw).norm();
+    assert!((segment.duration - FittsLaw::default().duration(travel)).abs() < 1e-9);
+    let analysis =
+        metrics::analyze(&robot, &planned.trajectory, &Span::of_plan(&planned), &MetricsOptions::default());
+    let patterns = &analysis.segments[0].patterns;
+    assert_eq!(patterns.phase1.hamp.to_string(), "ΦPO");
+    assert_eq!(patterns.phase2.hamp.to_string(), "ΦPO-PO");
 }

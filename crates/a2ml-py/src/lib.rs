@@ -10,6 +10,7 @@ mod decompose;
 mod language;
 mod compare;
 mod map;
+mod metrics;
 mod plan;
 
 use std::path::{Path, PathBuf};
@@ -124,6 +125,8 @@ impl From<CoreError> for PyErr {
             Error::Language(LanguageError::Invalid(d)) => Python::attach(|py| parse_error(py, &d)),
             Error::Language(LanguageError::Io { .. }) => PyOSError::new_err(message),
             Error::Output(_) => PyOSError::new_err(message),
+            Error::Read(a2ml_core::output::ReadError::Io { .. }) => PyOSError::new_err(message),
+            Error::Read(_) => PyValueError::new_err(message),
             Error::Kinematics(k) => match k {
                 KinematicsError::Unreachable { .. } => UnreachableError::new_err(message),
                 KinematicsError::JointOutOfLimits { .. } => JointLimitError::new_err(message),
@@ -581,6 +584,14 @@ fn _a2ml(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     m.add_function(wrap_pyfunction!(compare::compare, m)?)?;
     m.add_function(wrap_pyfunction!(map::swivel_map, m)?)?;
+    m.add_function(wrap_pyfunction!(metrics::_metrics_analyze, m)?)?;
+    m.add_function(wrap_pyfunction!(metrics::_metrics_similarity, m)?)?;
+    m.add_function(wrap_pyfunction!(metrics::_metrics_levenshtein, m)?)?;
+    m.add_function(wrap_pyfunction!(metrics::_metrics_connection_similarity, m)?)?;
+    m.add_function(wrap_pyfunction!(metrics::_metrics_mpcsi, m)?)?;
+    m.add_function(wrap_pyfunction!(metrics::_metrics_fitts_duration, m)?)?;
+    m.add_function(wrap_pyfunction!(metrics::_metrics_rula_table_a, m)?)?;
+    m.add_function(wrap_pyfunction!(metrics::_metrics_plan_handover, m)?)?;
     m.add("A2mlError", py.get_type::<A2mlError>())?;
     m.add("UrdfError", py.get_type::<UrdfError>())?;
     m.add("ParseError", py.get_type::<ParseError>())?;

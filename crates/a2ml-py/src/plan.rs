@@ -97,8 +97,8 @@ pub(crate) fn solver_choice(name: &str) -> PyResult<SolverChoice> {
 /// immutable. Keeps the `Robot` and `Task` it was planned from; pickles as its data.
 #[pyclass(frozen, module = "a2ml", name = "Plan")]
 pub(crate) struct PyPlan {
-    plan: Plan,
-    robot: Py<PyRobot>,
+    pub(crate) plan: Plan,
+    pub(crate) robot: Py<PyRobot>,
     task: Py<PyTask>,
 }
 
@@ -120,6 +120,12 @@ impl PyPlan {
     #[getter]
     fn qd<'py>(&self, py: Python<'py>) -> Matrix<'py> {
         joint_rows(py, self.plan.trajectory.velocities())
+    }
+
+    /// The human-likeness measures (`a2ml.metrics.analyze`): per-frame arrays and per-segment
+    /// summaries.
+    fn metrics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        crate::metrics::plan_metrics(py, &self.plan, &self.robot.get().robot)
     }
 
     /// Joint names, in the order of the columns of q.
@@ -272,7 +278,7 @@ impl PyPlan {
 }
 
 /// Joint vectors as the rows of an (N, 7) array.
-fn joint_rows<'py>(py: Python<'py>, rows: &[JointVector]) -> Matrix<'py> {
+pub(crate) fn joint_rows<'py>(py: Python<'py>, rows: &[JointVector]) -> Matrix<'py> {
     Array2::from_shape_fn((rows.len(), DOF), |(i, j)| rows[i][j]).into_pyarray(py)
 }
 

@@ -98,15 +98,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
     let recorded = read(&args.file)?;
     let robot = robot_of(args, &recorded)?;
     recorded.check_joints(&robot.joint_names())?;
-    let spans: Vec<Span> = recorded
-        .segments
-        .iter()
-        .map(|s| Span {
-            label: format!("{}/{}", s.action, s.segment + 1),
-            start: s.start,
-            end: s.end,
-        })
-        .collect();
+    let spans = Span::of_recorded(&recorded);
     let analysis =
         metrics::analyze(&robot, &recorded.trajectory, &spans, &MetricsOptions::default());
     let mut warnings = Vec::new();
@@ -149,6 +141,8 @@ fn row(table: &mut Table, m: &SpanMetrics) {
             sum_max,
             num(m.wrist_speed.peak_time_ratio, 2),
             num(m.wrist_speed.symmetry, 2),
+            m.speed_peaks.to_string(),
+            num(m.wrist_jerk, 1),
         ],
     );
 }
@@ -156,7 +150,7 @@ fn row(table: &mut Table, m: &SpanMetrics) {
 fn text(report: &Report<'_>) -> String {
     let mut table = Table::with_header([
         "span", "start (s)", "T (s)", "Fitts (s)", "×Fitts", "HAMP 1", "HAMP 2", "R_Φ",
-        "RULA A", "max", "UA+LA+W", "max", "peak t/T", "symmetry",
+        "RULA A", "max", "UA+LA+W", "max", "peak t/T", "symmetry", "peaks", "NJ wrist",
     ])
     .left_aligned([5, 6]);
     for segment in report.segments {

@@ -293,6 +293,7 @@ pub(crate) fn solve_error(file: &Path, error: SolveError) -> CliError {
         | SolveError::Rrt { .. }
         | SolveError::Map { .. }
         | SolveError::Baseline { .. }
+        | SolveError::Hamp { .. }
         | SolveError::Trajectory(_) => CliError::Planning(message),
     }
 }

@@ -49,6 +49,8 @@ fn agrees(value: &Value, m: &metrics::SpanMetrics, name: &str) {
     close(&value["fitts"]["fitts"], m.fitts.fitts, name);
     close(&value["wrist_speed"]["symmetry"], m.wrist_speed.symmetry, name);
     close(&value["wrist_speed"]["peak_time_ratio"], m.wrist_speed.peak_time_ratio, name);
+    close(&value["wrist_jerk"], m.wrist_jerk, name);
+    assert_eq!(value["speed_peaks"], m.speed_peaks as u64, "{name}");
 }
 
 #[test]

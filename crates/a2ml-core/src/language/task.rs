@@ -274,11 +274,13 @@ pub enum SolverChoice {
     Clik,
     /// λ0-PMP baseline.
     Pmp,
+    /// The HAMP handover planner (goal actions; docs/metrics.md).
+    Hamp,
 }
 
 impl SolverChoice {
     /// Every solver with its name.
-    pub const NAMES: [(&'static str, SolverChoice); 7] = [
+    pub const NAMES: [(&'static str, SolverChoice); 8] = [
         ("auto", SolverChoice::Auto),
         ("qp", SolverChoice::Qp),
         ("rrt", SolverChoice::Rrt),
@@ -286,6 +288,7 @@ impl SolverChoice {
         ("gpm", SolverChoice::Gpm),
         ("clik", SolverChoice::Clik),
         ("pmp", SolverChoice::Pmp),
+        ("hamp", SolverChoice::Hamp),
     ];
 
     /// The name used in task files.

@@ -670,7 +670,7 @@ impl Checker<'_> {
                 .map(|s| format!("did you mean `{s}`?"));
             self.error_with_help(
                 name.span,
-                format!("unknown solver `{}` (auto, qp, rrt, map, gpm, clik, pmp)", name.text),
+                format!("unknown solver `{}` (auto, qp, rrt, map, gpm, clik, pmp, hamp)", name.text),
                 help,
             );
         }

@@ -5,9 +5,11 @@
 use super::fitts::{FittsCheck, fitts_check};
 use super::pattern::{ElementSpeeds, PatternOptions, Phases, extract};
 use super::rula::{RulaAngles, RulaOptions, RulaScores, rula_angles};
+use super::smoothness::{path_normalised_jerk, speed_peaks};
 use crate::decompose::FittsLaw;
 use crate::kinematics::{arm_pose, cpsa_jacobian, cpsa_state, geometric_jacobian};
-use crate::math::{Real, Vector3};
+use crate::math::{JointVector, Real, Vector3};
+use crate::output::RecordedPlan;
 use crate::robot::Robot;
 use crate::solve::Plan;
 use crate::trajectory::Trajectory;
@@ -31,6 +33,8 @@ pub struct FrameMetrics {
     pub speeds: ElementSpeeds,
     /// Pw per sample in {b} (m).
     pub wrist: Vec<Vector3>,
+    /// q per sample (rad).
+    pub joints: Vec<JointVector>,
     /// θsw per sample (rad); NaN where the swivel angle is undefined.
     pub swivel: Vec<Real>,
     /// RULA angles per sample; `None` where the arm is straight.
@@ -47,6 +51,7 @@ pub fn frame_metrics(robot: &Robot, trajectory: &Trajectory, options: &RulaOptio
     let mut frames = FrameMetrics {
         speeds: ElementSpeeds { times: trajectory.times().to_vec(), ..ElementSpeeds::default() },
         wrist: Vec::with_capacity(n),
+        joints: trajectory.positions().to_vec(),
         swivel: Vec::with_capacity(n),
         rula_angles: Vec::with_capacity(n),
         rula: Vec::with_capacity(n),
@@ -87,6 +92,19 @@ impl Span {
     /// One span per segment of `plan`, labelled `action/segment` (1-based).
     pub fn of_plan(plan: &Plan) -> Vec<Span> {
         plan.segments
+            .iter()
+            .map(|s| Span {
+                label: format!("{}/{}", s.action, s.segment + 1),
+                start: s.start,
+                end: s.end,
+            })
+            .collect()
+    }
+
+    /// One span per segment record of a plan read back from a file.
+    pub fn of_recorded(recorded: &RecordedPlan) -> Vec<Span> {
+        recorded
+            .segments
             .iter()
             .map(|s| Span {
                 label: format!("{}/{}", s.action, s.segment + 1),
@@ -166,6 +184,12 @@ pub struct SpanMetrics {
     pub wrist_speed: BellShape,
     /// The span's duration against Fitts' law for the wrist's travel.
     pub fitts: FittsCheck,
+    /// Normalised jerk of the wrist path.
+    pub wrist_jerk: Real,
+    /// Normalised jerk of the joint path.
+    pub joint_jerk: Real,
+    /// Peaks of the wrist speed (above 5 % of its maximum, separated by 20 % dips).
+    pub speed_peaks: usize,
 }
 
 /// The samples of `times` within [start, end] (at least one).
@@ -200,6 +224,9 @@ pub fn span_metrics(frames: &FrameMetrics, span: &Span, options: &MetricsOptions
         rula_sum: summary(scored().map(|s| s.sum)),
         wrist_speed: bell_shape(&speeds.times, &speeds.position),
         fitts: fitts_check(&options.fitts, amplitude, duration),
+        wrist_jerk: path_normalised_jerk(&speeds.times, &frames.wrist[first..=last]),
+        joint_jerk: path_normalised_jerk(&speeds.times, &frames.joints[first..=last]),
+        speed_peaks: speed_peaks(&speeds.position),
     }
 }
 

@@ -13,7 +13,7 @@ use crate::kinematics::CpsaState;
 use crate::math::{Real, rotation_log, wrap_angle};
 
 /// A frame's primitive: the set of elements moving in it, written in the order Φ, P, O.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct Primitive {
     /// Φ, the swivel angle, moves.
     pub swivel: bool,
@@ -124,6 +124,12 @@ impl FromStr for Hamp {
             return Ok(Self::default());
         }
         text.split('-').map(str::parse).collect::<Result<_, _>>().map(Self)
+    }
+}
+
+impl serde::Serialize for Primitive {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(&self.to_string())
     }
 }
 

@@ -81,6 +81,20 @@ pub fn speed_peaks(speeds: &[Real]) -> usize {
     peaks + usize::from(rising && high - low >= threshold)
 }
 
+/// The normalised jerk of a motion given by its position samples (a wrist path, the joints):
+/// [`normalised_jerk`] of their velocities by differences at the interval middles.
+pub fn path_normalised_jerk<const N: usize>(times: &[Real], samples: &[SVector<Real, N>]) -> Real {
+    let n = times.len().min(samples.len());
+    if n < 2 {
+        return 0.0;
+    }
+    let middles: Vec<Real> = times[..n].windows(2).map(|w| 0.5 * (w[0] + w[1])).collect();
+    let velocities: Vec<SVector<Real, N>> = (1..n)
+        .map(|k| (samples[k] - samples[k - 1]) / (times[k] - times[k - 1]))
+        .collect();
+    normalised_jerk(&middles, &velocities)
+}
+
 /// The largest |value_i| / limit_i over the samples and components (0 for no sample).
 pub fn peak_ratio<const N: usize>(values: &[SVector<Real, N>], limits: &SVector<Real, N>) -> Real {
     values.iter().flat_map(|v| (0..N).map(move |i| v[i].abs() / limits[i])).fold(0.0, Real::max)

@@ -15,6 +15,7 @@ use super::constrained_rrt::{Chart, constrained_rrt_monitored, time_constrained}
 use super::control::{BaselineOptions, ControlError, ControlOptions, ControlRun};
 use super::map::{MapError, MapOptions, map_segment};
 use super::monitor::{Monitor, deadline_after};
+use super::hamp::{HampOptions, HandoverTarget, plan_handover};
 use super::qp::{self, Component, QpError, QpOptions, SegmentProblem};
 use super::report::{Fallback, Plan, QpStats, SegmentReport, VariableError};
 use super::rrt::{
@@ -190,6 +191,16 @@ pub enum SolveError {
     /// The decomposed task is too large, or an action starts too close to an obstacle.
     #[error(transparent)]
     Check(#[from] CheckError),
+    /// The HAMP planner failed on a segment.
+    #[error("action `{action}`, segment {}: hamp: {source}", segment + 1)]
+    Hamp {
+        /// The action.
+        action: String,
+        /// Segment index (0-based).
+        segment: usize,
+        /// Why.
+        source: super::hamp::HampError,
+    },
     /// Joining or resampling the segments failed.
     #[error("joining the segments: {0}")]
     Trajectory(#[from] TrajectoryError),
@@ -628,6 +639,7 @@ impl Solver<'_> {
             SolverChoice::Rrt if pattern == SegmentPattern::Goal => self.rrt(job, monitor),
             SolverChoice::Rrt => self.constrained(job, monitor),
             SolverChoice::Map => self.map(job),
+            SolverChoice::Hamp if pattern == SegmentPattern::Goal => self.hamp(job),
             SolverChoice::Gpm => self.baseline(job, SolverChoice::Gpm, |r, p, q, o, c| {
                 gpm::solve_segment(r, p, q, &o.gpm, c)
             }),
@@ -636,6 +648,11 @@ impl Solver<'_> {
             }),
             SolverChoice::Pmp => self.baseline(job, SolverChoice::Pmp, |r, p, q, o, c| {
                 pmp::solve_segment(r, p, q, &o.pmp, c)
+            }),
+            solver => Err(SolveError::UnsupportedSolver {
+                action: job.action.name.clone(),
+                solver,
+                pattern,
             }),
         }
     }
@@ -777,6 +794,29 @@ impl Solver<'_> {
             rrt: None,
             fallback: None,
         })
+
+    }
+
+    /// A goal segment by the HAMP handover planner towards its end state: the pick-up
+    /// patterns, timed by Fitts' law (METHODS.md §3.4).
+    fn hamp(&mut self, job: &Job) -> Result<Solved, SolveError> {
+        let failed = |source| SolveError::Hamp { action: job.action.name.clone(), segment: job.k, source };
+        let goal = ArmState::at(self.robot, &job.segment.end)
+            .map_err(|e| failed(super::hamp::HampError::Target(e)))?;
+        let target =
+            HandoverTarget { pw: goal.cpsa.pw, ow: goal.cpsa.ow, swivel: Some(goal.cpsa.swivel) };
+        let options = HampOptions {
+            seed: self.task.settings.seed,
+            rate: 1.0 / self.options.qp.step,
+            ..HampOptions::default()
+        };
+        let planned = plan_handover(self.robot, &self.q, &target, job.scene, &options).map_err(failed)?;
+        if !planned.limit_violations.is_empty() {
+            self.notes.push(format!("{}: the hamp motion exceeds a joint speed limit", job.name()));
+        }
+        let duration = planned.duration;
+        let timed = TimedPath { trajectory: planned.trajectory, duration, stretched: false };
+        Ok(Solved { solver: SolverChoice::Hamp, rrt: None, ..self.timed(job, timed, RrtStats::default()) })
     }
 
     fn rrt_options(&self) -> RrtOptions {

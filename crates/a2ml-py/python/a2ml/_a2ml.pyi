@@ -45,6 +45,14 @@ __all__ = [
     "ConvergenceError",
     "DecomposeError",
     "PlanError",
+    "_metrics_analyze",
+    "_metrics_connection_similarity",
+    "_metrics_fitts_duration",
+    "_metrics_levenshtein",
+    "_metrics_mpcsi",
+    "_metrics_plan_handover",
+    "_metrics_rula_table_a",
+    "_metrics_similarity",
 ]
 
 __version__: str
@@ -633,6 +641,12 @@ class Plan:
             OSError: the file cannot be written.
         """
 
+    def metrics(self) -> dict[str, Any]:
+        """The human-likeness measures of the plan, as
+        :func:`a2ml.metrics.analyze` returns them: ``frames`` (float64 arrays
+        per sample), ``whole`` and ``segments`` (summaries as ``a2ml analyze
+        --json`` prints them) and ``singular_frames``."""
+
     def to_json(self, path: str | os.PathLike[str]) -> None:
         """Write the plan as JSON: joint names, rate, trajectory, segment
         reports, wrist reference and warnings, with the a2ml version, robot
@@ -644,7 +658,7 @@ class Plan:
 
 def plan(
     task_or_path: Task | str | os.PathLike[str],
-    solver: Literal["auto", "qp", "rrt", "map", "gpm", "clik", "pmp"] | None = None,
+    solver: Literal["auto", "qp", "rrt", "map", "gpm", "clik", "pmp", "hamp"] | None = None,
     rate: float | None = None,
     seed: int | None = None,
     robot: Robot | None = None,
@@ -740,3 +754,41 @@ def swivel_map(
             without analytic IK.
     """
 
+
+
+def _metrics_analyze(plan_or_path: Plan | str | os.PathLike[str], robot: Robot | None = None) -> dict[str, Any]:
+    """Backs :func:`a2ml.metrics.analyze`."""
+
+def _metrics_similarity(h: str, s: str) -> float:
+    """Backs :func:`a2ml.metrics.similarity`."""
+
+def _metrics_levenshtein(h: str, s: str) -> int:
+    """Backs :func:`a2ml.metrics.levenshtein`."""
+
+def _metrics_connection_similarity(
+    h: str, s: str, target_share: float, population_shares: list[tuple[str, float]]
+) -> float:
+    """Backs :func:`a2ml.metrics.connection_similarity`."""
+
+def _metrics_mpcsi(
+    candidates: list[str], samples: list[str], population_shares: list[tuple[str, float]]
+) -> list[float]:
+    """Backs :func:`a2ml.metrics.mpcsi`."""
+
+def _metrics_fitts_duration(amplitude: float) -> float:
+    """Backs :func:`a2ml.metrics.fitts_duration`."""
+
+def _metrics_rula_table_a(upper_arm: int, lower_arm: int, wrist: int, wrist_twist: int) -> int:
+    """Backs :func:`a2ml.metrics.rula_table_a`."""
+
+def _metrics_plan_handover(
+    robot: Robot,
+    start: ArrayLike,
+    pw: ArrayLike,
+    ow: ArrayLike,
+    swivel: float | None = None,
+    handover: str = "pick_up",
+    seed: int = 0,
+    rate: float = 120.0,
+) -> dict[str, Any]:
+    """Backs :func:`a2ml.metrics.plan_handover`."""
