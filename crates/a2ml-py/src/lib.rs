@@ -9,6 +9,7 @@
 mod decompose;
 mod language;
 mod plan;
+mod plot;
 
 use std::path::{Path, PathBuf};
 
