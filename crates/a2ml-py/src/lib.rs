@@ -12,6 +12,7 @@ mod compare;
 mod map;
 mod metrics;
 mod plan;
+mod plot;
 
 use std::path::{Path, PathBuf};
 

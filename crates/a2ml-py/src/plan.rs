@@ -210,6 +210,39 @@ impl PyPlan {
         Ok(())
     }
 
+    /// The plan drawn as an SVG document: `kind` is one of `joints`, `velocities`,
+    /// `featured`, `distances`, `wrist`, `all`.
+    #[pyo3(signature = (kind="all"))]
+    fn to_svg(&self, py: Python<'_>, kind: &str) -> PyResult<String> {
+        let (robot, task) = (&self.robot.get().robot, &self.task.get().task);
+        crate::plot::svg(py, robot, task, &self.plan, crate::plot::kind(kind)?)
+    }
+
+    /// Writes the plan drawn as `kind` (as [`Self::to_svg`]) to an SVG file.
+    #[pyo3(signature = (path, kind="all"))]
+    fn plot(&self, py: Python<'_>, path: PathBuf, kind: &str) -> PyResult<()> {
+        let (robot, task) = (&self.robot.get().robot, &self.task.get().task);
+        crate::plot::write(py, &path, robot, task, &self.plan, crate::plot::kind(kind)?)
+    }
+
+    /// The self-contained HTML report: summary, segments, motion playback, plots, task.
+    fn to_html(&self, py: Python<'_>) -> PyResult<String> {
+        let (robot, task) = (&self.robot.get().robot, self.task.get());
+        crate::plot::html(py, robot, &task.task, &task.source, &self.plan)
+    }
+
+    /// Writes the HTML report (as [`Self::to_html`]) to a file.
+    fn write_report(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let (robot, task) = (&self.robot.get().robot, self.task.get());
+        crate::plot::write_report(py, &path, robot, &task.task, &task.source, &self.plan)
+    }
+
+    /// The notebook view: the segment table and the joint plot.
+    fn _repr_html_(&self, py: Python<'_>) -> PyResult<String> {
+        let (robot, task) = (&self.robot.get().robot, &self.task.get().task);
+        crate::plot::notebook(py, robot, task, &self.plan)
+    }
+
     /// Pickles as `Plan._from_state(robot, task, state)`.
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
         let py = slf.py();

@@ -656,6 +656,44 @@ class Plan:
             OSError: the file cannot be written.
         """
 
+    def to_svg(self, kind: Literal["joints", "velocities", "featured", "distances", "wrist", "all"] = "all") -> str:
+        """The plan drawn as an SVG document (no matplotlib, no fonts loaded):
+        ``joints`` (positions, limits shaded, segment boundaries numbered),
+        ``velocities`` (and accelerations, against the speed limits),
+        ``featured`` (each segment's featured variables against their
+        reference and goal), ``distances`` (each arm capsule to each obstacle,
+        with the safety distance), ``wrist`` (three orthographic views) or
+        ``all`` on one page; what ``a2ml plot --kind`` draws. Releases the GIL.
+
+        Raises:
+            ValueError: an unknown kind.
+        """
+
+    def plot(self, path: str | os.PathLike[str], kind: Literal["joints", "velocities", "featured", "distances", "wrist", "all"] = "all") -> None:
+        """Write :meth:`to_svg` of ``kind`` to an SVG file. Atomic as
+        :meth:`write_mcap`; releases the GIL.
+
+        Raises:
+            ValueError: an unknown kind.
+            OSError: the file cannot be written.
+        """
+
+    def to_html(self) -> str:
+        """One self-contained HTML page (nothing fetched): summary and
+        warnings, the segment table, the motion in a front and a top view with
+        a play button and a time slider, every plot, and the task's text.
+        Releases the GIL."""
+
+    def write_report(self, path: str | os.PathLike[str]) -> None:
+        """Write :meth:`to_html` to a file. Atomic as :meth:`write_mcap`.
+
+        Raises:
+            OSError: the file cannot be written.
+        """
+
+    def _repr_html_(self) -> str:
+        """A notebook's view: the caption, the segment table and the joint plot."""
+
 def plan(
     task_or_path: Task | str | os.PathLike[str],
     solver: Literal["auto", "qp", "rrt", "map", "gpm", "clik", "pmp", "hamp"] | None = None,
