@@ -166,6 +166,13 @@ pub trait Resolver {
         q: &JointVector,
         t: Real,
     ) -> Result<Resolved, ControlError>;
+
+    /// An upper bound of the closed loop's fastest rate (1/s) near `pose`, for RK4's
+    /// substeps; 0 (the default) when the control step is always small enough.
+    fn fastest_rate(&self, pose: &ArmPose) -> Real {
+        let _ = pose;
+        0.0
+    }
 }
 
 /// A segment run through the loop.
@@ -210,9 +217,9 @@ fn check_options(o: &ControlOptions) -> Result<(), ControlError> {
 ///
 /// # Errors
 /// [`ControlError`]: invalid settings, a resolver error, or non-finite samples.
-pub fn run(
+pub fn run<R: Resolver>(
     robot: &Robot,
-    resolver: &mut impl Resolver,
+    resolver: &mut R,
     q0: &JointVector,
     duration: Real,
     options: &ControlOptions,
@@ -226,7 +233,7 @@ pub fn run(
     let settle_steps = (options.max_settle / h).ceil() as usize;
     let window = ((options.stall_window / h).ceil() as usize).max(1);
     let ramp = options.start_ramp;
-    let mut call = |q: &JointVector, t: Real| {
+    let call = |resolver: &mut R, q: &JointVector, t: Real| {
         let mut resolved = resolver.resolve(&arm_pose(robot, q), q, t)?;
         if t < ramp {
             resolved.velocity *= 0.5 * (1.0 - (std::f64::consts::PI * t / ramp).cos());
@@ -242,7 +249,7 @@ pub fn run(
     let (reached, stalled) = loop {
         let started = Instant::now();
         let t = k as Real * h;
-        let now = call(&q, t)?;
+        let now = call(resolver, &q, t)?;
         times.push(t);
         positions.push(q);
         velocities.push(now.velocity);
@@ -261,10 +268,20 @@ pub fn run(
         q = match options.integration {
             Integration::Euler => q + now.velocity * h,
             Integration::Rk4 => {
-                let k2 = call(&(q + now.velocity * (h / 2.0)), t + h / 2.0)?.velocity;
-                let k3 = call(&(q + k2 * (h / 2.0)), t + h / 2.0)?.velocity;
-                let k4 = call(&(q + k3 * h), t + h)?.velocity;
-                q + (now.velocity + (k2 + k3) * 2.0 + k4) * (h / 6.0)
+                // Substeps keep RK4 inside its stability region (|rate · step| ≤ 1 < 2.78).
+                let rate = resolver.fastest_rate(&arm_pose(robot, &q));
+                let n = (rate * h).ceil().clamp(1.0, 1e4) as usize;
+                let d = h / n as Real;
+                let mut p = q;
+                for i in 0..n {
+                    let s = t + i as Real * d;
+                    let k1 = if i == 0 { now.velocity } else { call(resolver, &p, s)?.velocity };
+                    let k2 = call(resolver, &(p + k1 * (d / 2.0)), s + d / 2.0)?.velocity;
+                    let k3 = call(resolver, &(p + k2 * (d / 2.0)), s + d / 2.0)?.velocity;
+                    let k4 = call(resolver, &(p + k3 * d), s + d)?.velocity;
+                    p += (k1 + (k2 + k3) * 2.0 + k4) * (d / 6.0);
+                }
+                p
             }
         };
         if q.iter().any(|x| !x.is_finite()) {

@@ -248,6 +248,16 @@ impl Resolver for Pmp {
         };
         Ok(Resolved { velocity: JointVector::from_column_slice(velocity.as_slice()), error: score })
     }
+
+    /// k λ_max(J W⁻¹ Jᵀ): the task moves as x' = B⁻¹K(t)(x_d - x), and for m = 6 (metres and
+    /// radians together) J W⁻¹ Jᵀ is badly conditioned, so with eq. 10's k this rate can
+    /// reach thousands per second.
+    fn fastest_rate(&self, pose: &ArmPose) -> Real {
+        let j = task_jacobian(self.task, pose);
+        let weighted = &j * DMatrix::from_diagonal(&self.w_inverse) * j.transpose();
+        // The elastic null-space motion decays at W⁻¹K_J = 1/τ0.
+        (self.k * weighted.symmetric_eigen().eigenvalues.max()).max(1.0 / self.tau)
+    }
 }
 
 /// One segment by PMP from `q0` towards the segment's goal hand pose; the clock of the ramp

@@ -32,6 +32,7 @@ __all__ = [
     "Task",
     "parse",
     "load",
+    "compare",
     "decompose",
     "plan",
     "Plan",
