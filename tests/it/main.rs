@@ -18,3 +18,4 @@ mod robots;
 mod rrt;
 mod segments;
 mod swivel;
+mod visuals;

@@ -1,6 +1,7 @@
 //! End-to-end tests of the `a2ml` binary, one module per area: output,
 //! files written and exit codes.
 
+mod examples;
 mod explain;
 mod language;
 mod plan;
