@@ -25,3 +25,4 @@ mod rrt;
 mod segments;
 mod smoothness;
 mod swivel;
+mod visuals;

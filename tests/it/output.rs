@@ -11,19 +11,17 @@ use a2ml::decompose::{ActionType, SegmentPattern};
 use a2ml::kinematics::{arm_pose, link_poses};
 use a2ml::language::{Shape, SolverChoice, Space, Task, Variable, parse};
 use a2ml::math::{JointVector, Real, Vector3};
-use a2ml::output::{ARM_CAPSULE_RATE, OutputError, topics, write_csv, write_json, write_mcap};
+use a2ml::output::{OutputError, topics, write_csv, write_json, write_mcap};
 use a2ml::solve::{Fallback, Plan, QpStats, SegmentReport, VariableError};
 use a2ml::trajectory::{Clearance, Trajectory};
 use serde_json::Value;
 
 use crate::common::{self, load};
 
-/// Output rate of the test plan (Hz): above [`ARM_CAPSULE_RATE`], so capsules are thinned.
+/// Output rate of the test plan (Hz).
 const RATE: Real = 250.0;
 /// Number of samples: 0.4 s at [`RATE`].
 const SAMPLES: usize = 101;
-/// Fields that may be null although their schema gives another type (see `schemas.rs`).
-const NULLABLE: [&str; 6] = ["cpsa", "hat", "action_type", "clearance", "rrt", "fallback"];
 
 /// The task of an example file, with its source.
 fn task(name: &str) -> (Task, String) {
@@ -160,10 +158,6 @@ fn conforms(value: &Value, schema: &Value, at: &str) -> Result<(), String> {
             .then_some(())
             .ok_or(format!("{at}: {value} is not one of {options:?}"));
     }
-    let field = at.rsplit('.').next().unwrap_or(at);
-    if value.is_null() && NULLABLE.contains(&field) {
-        return Ok(());
-    }
     let kind = schema["type"].as_str().ok_or(format!("{at}: schema without a type"))?;
     let fits = match kind {
         "object" => return object_conforms(value, schema, at),
@@ -207,6 +201,15 @@ fn xyz(v: &Value) -> Vector3 {
     )
 }
 
+/// The transform of a `foxglove.FrameTransform`.
+fn isometry(t: &Value) -> a2ml::math::Isometry {
+    let o = &t["rotation"];
+    let [x, y, z, w] = ["x", "y", "z", "w"].map(|k| o[k].as_f64().expect("component"));
+    let rotation =
+        a2ml::math::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z));
+    a2ml::math::Isometry::from_parts(xyz(&t["translation"]).into(), rotation.to_rotation_matrix())
+}
+
 fn nanos(t: Real) -> u64 {
     (t * 1e9).round() as u64
 }
@@ -222,6 +225,7 @@ fn every_channel_has_its_schema_and_encoding() {
         (topics::WRIST_PATH, "foxglove.SceneUpdate"),
         (topics::STATE, "a2ml.State"),
         (topics::SEGMENTS, "a2ml.Segment"),
+        (topics::ROBOT_DESCRIPTION, "std_msgs/String"),
     ];
     let found: BTreeSet<&str> = recording.schemas.keys().map(String::as_str).collect();
     assert_eq!(found, expected.iter().map(|(t, _)| *t).collect());
@@ -233,6 +237,7 @@ fn every_channel_has_its_schema_and_encoding() {
     }
     let summary = mcap::Summary::read(&recording.bytes).expect("readable").expect("a summary");
     assert!(!summary.chunk_indexes.is_empty(), "chunked, with an index");
+    assert!(summary.chunk_indexes.iter().all(|c| c.compression == "zstd"), "zstd chunks");
     assert_eq!(summary.channels.len(), expected.len());
 }
 
@@ -245,13 +250,12 @@ fn message_counts_follow_the_samples() {
     for topic in [topics::JOINT_STATES, topics::TF, topics::STATE] {
         assert_eq!(count(topic), n, "{topic}");
     }
-    assert_eq!(count(topics::SCENE), 1);
-    assert_eq!(count(topics::WRIST_PATH), 1);
+    for topic in
+        [topics::SCENE, topics::WRIST_PATH, topics::ARM_CAPSULES, topics::ROBOT_DESCRIPTION]
+    {
+        assert_eq!(count(topic), 1, "{topic} is sent once");
+    }
     assert_eq!(count(topics::SEGMENTS), plan.segments.len());
-    // Every third sample at 250 Hz (≤ 100 Hz), and the last one.
-    let stride = (RATE / ARM_CAPSULE_RATE).ceil() as usize;
-    let thinned = (n - 1) / stride + 1 + usize::from((n - 1) % stride != 0);
-    assert_eq!(count(topics::ARM_CAPSULES), thinned);
 }
 
 #[test]
@@ -328,6 +332,8 @@ fn joint_states_and_transforms_follow_the_trajectory() {
     let trajectory = &plan.trajectory;
     for (i, (_, _, m)) in recording.messages[topics::JOINT_STATES].iter().enumerate() {
         assert_eq!(m["name"], serde_json::json!(plan.joint_names));
+        assert_eq!(m["lower"], serde_json::json!(robot.lower().as_slice()));
+        assert_eq!(m["upper"], serde_json::json!(robot.upper().as_slice()));
         for j in 0..7 {
             let (q, qd) = (trajectory.positions()[i][j], trajectory.velocities()[i][j]);
             assert!((m["position"][j].as_f64().expect("q") - q).abs() <= 1e-12 * q.abs());
@@ -339,12 +345,19 @@ fn joint_states_and_transforms_follow_the_trajectory() {
     let poses = link_poses(&robot, &arm_pose(&robot, &trajectory.positions()[last]));
     let transforms = transforms.as_array().expect("transforms");
     assert_eq!(transforms.len(), robot.links.len());
+    // The links as a tree (each from the one before it, the first from "b"): composed from
+    // the root, every link lands on its pose in {b}.
+    let mut b_from_parent = a2ml::math::Isometry::identity();
+    let mut parent = "b";
     for ((t, link), pose) in transforms.iter().zip(&robot.links).zip(&poses) {
         assert_eq!(
             (t["parent_frame_id"].as_str(), t["child_frame_id"].as_str()),
-            (Some("b"), Some(link.name.as_str()))
+            (Some(parent), Some(link.name.as_str()))
         );
-        assert!((xyz(&t["translation"]) - pose.translation.vector).norm() < 1e-12);
+        let b_from_link = b_from_parent * isometry(t);
+        assert!((b_from_link.translation.vector - pose.translation.vector).norm() < 1e-12);
+        assert!((b_from_link.rotation.matrix() - pose.rotation.matrix()).norm() < 1e-12);
+        (b_from_parent, parent) = (b_from_link, link.name.as_str());
     }
     // The base link's transform places the URDF in {b}.
     let base = &transforms[0];
@@ -383,23 +396,76 @@ fn a_scene_written_in_the_root_frame_is_drawn_in_the_base_frame() {
 }
 
 #[test]
-fn the_arm_capsules_follow_the_arm() {
+fn the_arm_capsules_ride_on_their_links() {
     let (robot, _, _, plan, recording) = written("capsules", "construct_scene.a2ml");
-    let (last_time, _, last) = recording.messages[topics::ARM_CAPSULES].last().expect("some");
-    assert_eq!(*last_time, nanos(plan.trajectory.end()));
-    let pose = arm_pose(&robot, plan.trajectory.positions().last().expect("a sample"));
-    let capsules = a2ml::collision::arm_capsules(&robot, &pose);
-    let entities = last["entities"].as_array().expect("entities");
-    assert_eq!(entities.len(), capsules.len());
-    for (e, c) in entities.iter().zip(&capsules) {
-        let caps: Vec<Vector3> = e["spheres"]
-            .as_array()
-            .expect("caps")
-            .iter()
-            .map(|s| xyz(&s["pose"]["position"]))
-            .collect();
-        assert!((caps[0] - c.a).norm() < 1e-12 && (caps[1] - c.b).norm() < 1e-12);
+    let [(time, _, update)] = recording.messages[topics::ARM_CAPSULES].as_slice() else {
+        panic!("the capsules are sent once")
+    };
+    assert_eq!(*time, nanos(plan.trajectory.start()));
+    let entities = update["entities"].as_array().expect("entities");
+    assert_eq!(entities.len(), robot.capsules.len());
+    // At every tenth sample, the caps placed by their link's pose (composed from /tf) are
+    // where the collision model puts the capsule's ends.
+    let tf = &recording.messages[topics::TF];
+    for (i, q) in plan.trajectory.positions().iter().enumerate().step_by(10) {
+        let mut b_from = BTreeMap::from([("b".to_owned(), a2ml::math::Isometry::identity())]);
+        for t in tf[i].2["transforms"].as_array().expect("transforms") {
+            let parent = b_from[t["parent_frame_id"].as_str().expect("parent")];
+            b_from
+                .insert(t["child_frame_id"].as_str().expect("child").into(), parent * isometry(t));
+        }
+        let capsules = a2ml::collision::arm_capsules(&robot, &arm_pose(&robot, q));
+        for (e, c) in entities.iter().zip(&capsules) {
+            assert_eq!(e["frame_locked"], true);
+            let b_from_link = b_from[e["frame_id"].as_str().expect("a link frame")];
+            let caps: Vec<Vector3> = e["spheres"]
+                .as_array()
+                .expect("caps")
+                .iter()
+                .map(|s| b_from_link.transform_point(&xyz(&s["pose"]["position"]).into()).coords)
+                .collect();
+            assert!((caps[0] - c.a).norm() < 1e-9 && (caps[1] - c.b).norm() < 1e-9, "sample {i}");
+        }
     }
+}
+
+#[test]
+fn the_robot_description_is_the_urdf() {
+    let (robot, .., recording) = written("description", "construct_scene.a2ml");
+    let [(_, _, message)] = recording.messages[topics::ROBOT_DESCRIPTION].as_slice() else {
+        panic!("sent once")
+    };
+    assert_eq!(message["data"].as_str(), Some(robot.urdf.as_str()));
+}
+
+#[test]
+fn the_files_are_the_same_bytes_every_time() {
+    let robot = load("coman_right_arm");
+    let (task, source) = task("construct_scene.a2ml");
+    let plan = plan(&robot);
+    let dir = scratch("reproducible");
+    let bytes = |name: &str| -> [Vec<u8>; 3] {
+        let [mcap, csv, json] = ["mcap", "csv", "json"].map(|e| dir.join(format!("{name}.{e}")));
+        write_mcap(&mcap, &robot, &task, &source, &plan).expect("mcap");
+        write_csv(&csv, &robot, &plan).expect("csv");
+        write_json(&json, &robot, &task, &plan).expect("json");
+        [mcap, csv, json].map(|p| fs::read(p).expect("written"))
+    };
+    let mut timed = plan.clone();
+    // Wall-clock timings differ from run to run; the files must not show them.
+    timed.segments[0].qp.mean_step_time = 1.25e-3;
+    timed.segments[0].qp.worst_step_time = 9.5e-3;
+    let first = bytes("first");
+    let again = bytes("again");
+    assert_eq!(first, again);
+    let json = String::from_utf8(first[2].clone()).expect("UTF-8");
+    assert!(!json.contains("step_time"), "no timings");
+    let dir_timed = scratch("reproducible_timed");
+    let [mcap, json_path] = ["mcap", "json"].map(|e| dir_timed.join(format!("plan.{e}")));
+    write_mcap(&mcap, &robot, &task, &source, &timed).expect("mcap");
+    write_json(&json_path, &robot, &task, &timed).expect("json");
+    assert_eq!(fs::read(mcap).expect("written"), first[0], "MCAP without timings");
+    assert_eq!(fs::read(json_path).expect("written"), first[2], "JSON without timings");
 }
 
 #[test]
@@ -454,8 +520,10 @@ fn each_segment_is_recorded_at_its_start() {
     assert_eq!(records[0]["space"], "Cpsa");
     assert_eq!(records[0]["solver"], "qp");
     assert_eq!(records[0]["focus"], serde_json::json!(["Pw", "Ow"]));
-    assert!(records[0]["clearance"].is_null());
-    assert_eq!(records[1]["action_type"], Value::Null);
+    assert!(records[0].get("clearance").is_none(), "absent, not null");
+    assert!(records[1].get("action_type").is_none());
+    assert!(records[0].get("rrt").is_none() && records[0].get("fallback").is_none());
+    assert_eq!(records[0]["qp"], serde_json::json!({ "steps": 40, "clarabel_steps": 0 }));
     assert_eq!(records[1]["clearance"]["obstacle"], "table");
     assert_eq!(records[1]["path_errors"][0]["variable"], "Swivel");
     assert_eq!(records[1]["start"].as_f64(), Some(plan.segments[1].start));

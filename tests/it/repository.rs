@@ -73,3 +73,29 @@ fn vendored_test_data_is_in_the_repository() {
     let readme = std::fs::read_to_string(data.join("README.md")).expect("tests/data/README.md");
     assert!(readme.contains("panda_sphere_cage.json"), "the README says where the file came from");
 }
+
+#[test]
+fn the_foxglove_layout_shows_the_written_topics() {
+    use a2ml::output::topics;
+    let text = std::fs::read_to_string(root().join("docs/foxglove_layout.json"))
+        .expect("docs/foxglove_layout.json");
+    let layout: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+    let panels = layout["configById"].as_object().expect("panels by id");
+    let (_, three_d) = panels.iter().find(|(id, _)| id.starts_with("3D!")).expect("a 3D panel");
+    assert_eq!(three_d["followTf"], "b", "the 3D panel opens on frame b");
+    for topic in
+        [topics::ROBOT_DESCRIPTION, topics::ARM_CAPSULES, topics::SCENE, topics::WRIST_PATH]
+    {
+        assert_eq!(three_d["topics"][topic]["visible"], true, "{topic}");
+    }
+    let written = [topics::JOINT_STATES, topics::STATE, topics::SEGMENTS];
+    let mut joints_with_limits = 0;
+    for (id, panel) in panels {
+        for path in panel["paths"].as_array().into_iter().flatten() {
+            let value = path["value"].as_str().expect("a message path");
+            assert!(written.iter().any(|t| value.starts_with(&format!("{t}."))), "{id}: {value}");
+            joints_with_limits += usize::from(value.starts_with("/joint_states.upper["));
+        }
+    }
+    assert_eq!(joints_with_limits, 7, "each joint is plotted against its limits");
+}

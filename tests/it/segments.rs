@@ -1,6 +1,6 @@
 //! The seven action types decomposed on COMAN and Centauro: the segment
 //! structure of paper fig. 3 and eq. 12, and goals consistent with the
-//! constraints (DESIGN.md §4). Tasks are written from real configurations
+//! constraints (docs/design.md §4). Tasks are written from real configurations
 //! so that their goals are reachable.
 
 use crate::common::{load, nearby, regular_q, rng, robot_path};

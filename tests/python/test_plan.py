@@ -2,7 +2,9 @@
 (from a path and from a Task), the arrays and reports of a Plan, the errors,
 determinism and pickling, and the writers: the CSV read back with numpy, the
 JSON with json, and the MCAP with the independent reader of the ``mcap``
-package (channels, schemas, counts, log times, payloads, attachments)."""
+package (channels, schemas, counts, log times, payloads, attachments), every
+message validated with jsonschema against its embedded schema and the Foxglove
+ones against Foxglove's official schemas."""
 
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
+import jsonschema
 import numpy as np
 import pytest
 from mcap.reader import make_reader
@@ -34,7 +37,12 @@ SCHEMAS = {
     "/wrist_path": "foxglove.SceneUpdate",
     "/a2ml/state": "a2ml.State",
     "/a2ml/segments": "a2ml.Segment",
+    "/arm_capsules": "foxglove.SceneUpdate",
+    "/robot_description": "std_msgs/String",
 }
+
+# Foxglove's own JSON Schemas (vendored from foxglove/schemas, see tests/data/README.md).
+FOXGLOVE_SCHEMAS = TESTS_DIR / ".." / "data" / "foxglove_schemas"
 
 
 @pytest.fixture(scope="module")
@@ -384,8 +392,9 @@ def test_mcap_message_counts(plan: Plan, recording: Recording) -> None:
     assert counts["/tf"] == samples
     assert counts["/a2ml/state"] == samples
     assert counts["/a2ml/segments"] == len(plan.segments)
-    assert counts["/scene"] >= 1
-    assert counts["/wrist_path"] >= 1
+    # Sent once: what does not change over the plan (the capsules ride on /tf).
+    for topic in ["/scene", "/wrist_path", "/arm_capsules", "/robot_description"]:
+        assert counts[topic] == 1, topic
     statistics = recording.summary.statistics
     assert statistics is not None
     assert statistics.message_count == sum(counts.values())
@@ -465,3 +474,53 @@ def test_auto_goes_on_to_the_rrt_when_the_qp_leaves_a_hard_path() -> None:
     assert segment.path_errors["pw"].error < 1e-9
     assert segment.to_dict()["fallback"] == "qp_left_path"
     assert pickle.loads(pickle.dumps(segment)) == segment
+
+
+def test_mcap_foxglove_messages_pass_the_official_schemas(recording: Recording) -> None:
+    official = {
+        name: json.loads((FOXGLOVE_SCHEMAS / f"{name}.json").read_text(encoding="utf-8"))
+        for name in ["SceneUpdate", "FrameTransforms"]
+    }
+    checked = 0
+    for topic, (schema_name, _, _) in recording.schemas.items():
+        if not schema_name.startswith("foxglove."):
+            continue
+        schema = official[schema_name.removeprefix("foxglove.")]
+        validator = jsonschema.Draft202012Validator(schema)
+        for _, message in recording.messages[topic]:
+            validator.validate(message)
+            checked += 1
+    assert checked >= len(recording.messages["/tf"]) + 3
+
+
+def test_mcap_own_messages_pass_their_embedded_schemas(recording: Recording) -> None:
+    for topic, (_, _, schema) in recording.schemas.items():
+        validator = jsonschema.Draft202012Validator(schema)
+        for _, message in recording.messages[topic]:
+            validator.validate(message)
+
+
+def test_mcap_robot_description_and_capsules(plan: Plan, recording: Recording) -> None:
+    [(_, description)] = recording.messages["/robot_description"]
+    assert description["data"] == Path(plan.task.robot).read_text(encoding="utf-8")
+    assert "<visual" in description["data"]
+    [(_, capsules)] = recording.messages["/arm_capsules"]
+    frames = {t["child_frame_id"] for t in recording.messages["/tf"][0][1]["transforms"]}
+    for entity in capsules["entities"]:
+        assert entity["frame_locked"] is True
+        assert entity["frame_id"] in frames, entity["frame_id"]
+
+
+def test_plan_files_are_byte_for_byte_reproducible(tmp_path: Path) -> None:
+    """Two plans of one task write the same bytes: the files hold no wall-clock
+    times, which stay in the report objects."""
+    first, second = a2ml.plan(EXAMPLE), a2ml.plan(EXAMPLE)
+    for name, p in (("first", first), ("second", second)):
+        p.write_mcap(tmp_path / f"{name}.mcap")
+        p.to_csv(tmp_path / f"{name}.csv")
+        p.to_json(tmp_path / f"{name}.json")
+    for suffix in ("mcap", "csv", "json"):
+        a = (tmp_path / f"first.{suffix}").read_bytes()
+        assert a == (tmp_path / f"second.{suffix}").read_bytes(), suffix
+    assert all(s.qp.mean_step_time > 0.0 for s in first.segments)
+    assert b"step_time" not in (tmp_path / "first.json").read_bytes()

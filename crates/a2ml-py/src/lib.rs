@@ -1,7 +1,7 @@
 //! Python bindings of a2ml-core, built by maturin into the `a2ml` wheel as
 //! `a2ml._a2ml`. Thin by design: every method converts its inputs, calls
 //! the core and converts the result; all kinematics lives in the core.
-//! Arrays cross as float64 numpy arrays; frames and units as in DESIGN.md §2.
+//! Arrays cross as float64 numpy arrays; frames and units as in docs/design.md §2.
 //! The task language is in [`language`], the decomposition in
 //! [`decompose`], planning and its outputs in [`plan`]; exceptions and their
 //! mapping here.

@@ -1,5 +1,5 @@
 //! `a2ml.plan`, `a2ml.Plan` and `a2ml.SegmentReport`: a task planned into one joint
-//! trajectory at the output rate, what each segment did, and the writers of DESIGN.md §6.
+//! trajectory at the output rate, what each segment did, and the writers of docs/design.md §6.
 //!
 //! Arrays are float64: `t` (N,) s, `q` and `qd` (N, 7) rad and rad/s, the wrist reference
 //! (M, 4) as t, x, y, z (s, m in {b}). Reports are spelled as [`crate::decompose`] spells

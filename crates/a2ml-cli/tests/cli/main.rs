@@ -4,6 +4,7 @@
 mod analyze;
 mod compare;
 mod bounds;
+mod examples;
 mod explain;
 mod language;
 mod outputs;

@@ -1,5 +1,5 @@
 //! The whole decomposition: every action, in planned order, to fully
-//! parameterised movement segments (DESIGN.md §4, paper fig. 3, eq. 12).
+//! parameterised movement segments (docs/design.md §4, paper fig. 3, eq. 12).
 //!
 //! Actions run one after another from the task's start configuration; each
 //! segment records the configuration it is expected to start and end in, so
@@ -248,7 +248,7 @@ impl Planner<'_> {
         })
     }
 
-    /// The rows of DESIGN.md §4's table.
+    /// The rows of docs/design.md §4's table.
     fn table(
         &self,
         c: &Classification,

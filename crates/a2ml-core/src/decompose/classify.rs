@@ -1,4 +1,4 @@
-//! The seven action types (paper fig. 3, DESIGN.md §4): a table lookup on
+//! The seven action types (paper fig. 3, docs/design.md §4): a table lookup on
 //! an action's goal constraint GC and path constraint PC.
 //!
 //! Two cases the table leaves open are settled here:

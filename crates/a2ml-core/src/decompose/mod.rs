@@ -1,4 +1,4 @@
-//! From a validated task to movement segments (DESIGN.md §4, paper §5.1-5.2).
+//! From a validated task to movement segments (docs/design.md §4, paper §5.1-5.2).
 //!
 //! Entry points: [`order`] (the action sequence: a STRIPS plan from `init`
 //! to `goal`, or the written order), [`classify`] (an action's type I-VII

@@ -1,4 +1,4 @@
-//! Opt1 and Opt2 (paper eq. 5, 6, 13, 14; DESIGN.md §4): the small
+//! Opt1 and Opt2 (paper eq. 5, 6, 13, 14; docs/design.md §4): the small
 //! optimisations that reconcile constraints given in different spaces.
 //!
 //! Both work on the variables of one space. The fixed ones come from a goal

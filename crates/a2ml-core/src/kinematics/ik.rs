@@ -1,4 +1,4 @@
-//! Inverse kinematics from CPSA and HAT states to joints (DESIGN.md §3).
+//! Inverse kinematics from CPSA and HAT states to joints (docs/design.md §3).
 //!
 //! Arms whose shoulder axes meet in a point and whose wrist axes meet in a
 //! point are solved in closed form, elbow offsets allowed: the triangle

@@ -4,7 +4,7 @@
 //! Entry points: [`arm_pose`] (everything FK knows at q), the state
 //! functions [`cpsa_state`] / [`hat_state`] with their 7x7 Jacobians, the
 //! mapping [`cpsa_to_hat`] / [`hat_to_cpsa`], IK [`ik_cpsa`] / [`ik_hat`]
-//! and [`swivel_intervals`]. Frames and signs follow DESIGN.md §2-3: all in
+//! and [`swivel_intervals`]. Frames and signs follow docs/design.md §2-3: all in
 //! {b}, origin at the shoulder centre.
 
 mod error;

@@ -1,5 +1,5 @@
 //! The CPSA and HAT representation spaces: states, 7x7 Jacobians and the
-//! mapping between them (DESIGN.md §3, paper eq. 8, 10-11, appendix B).
+//! mapping between them (docs/design.md §3, paper eq. 8, 10-11, appendix B).
 
 use super::error::{KinematicsError, Singularity};
 use super::fk::{ArmPose, geometric_jacobian, point_jacobian};

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use super::ast::Span;
 use crate::math::{JointVector, Real, Rotation3, Vector3};
 
-/// The two representation spaces (DESIGN.md §3).
+/// The two representation spaces (docs/design.md §3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
 pub enum Space {
     /// (Pw, Ow, θsw).
@@ -260,7 +260,7 @@ pub enum ActionBody {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SolverChoice {
-    /// DESIGN.md §5 policy.
+    /// docs/design.md §5 policy.
     Auto,
     /// Velocity QP.
     Qp,

@@ -5,14 +5,13 @@ use std::collections::BTreeMap;
 use std::io::{Seek, Write};
 
 use mcap::records::{MessageHeader, Metadata};
-use mcap::{Attachment, McapError, Writer};
+use mcap::{Attachment, Compression, McapError, WriteOptions, Writer};
 use serde::Serialize;
 
 use super::atomic::Failure;
-use super::messages::{self, StateSeries, Time};
+use super::messages::{self, JointLimits, StateSeries, Time};
 use super::schemas::{self, Schema};
-use super::{ARM_CAPSULE_RATE, topics};
-use crate::collision;
+use super::topics;
 use crate::kinematics::{arm_pose, cpsa_state, hat_state, link_poses};
 use crate::language::Task;
 use crate::math::{Real, Vector3};
@@ -63,6 +62,7 @@ struct Topics {
     wrist_path: Topic,
     state: Topic,
     segments: Topic,
+    robot_description: Topic,
 }
 
 fn add_topic<W: Write + Seek>(
@@ -86,6 +86,11 @@ fn add_topics<W: Write + Seek>(writer: &mut Writer<W>) -> Result<Topics, Failure
         wrist_path: add_topic(writer, topics::WRIST_PATH, &scene)?,
         state: add_topic(writer, topics::STATE, &schemas::state())?,
         segments: add_topic(writer, topics::SEGMENTS, &schemas::segment())?,
+        robot_description: add_topic(
+            writer,
+            topics::ROBOT_DESCRIPTION,
+            &schemas::robot_description(),
+        )?,
     })
 }
 
@@ -139,13 +144,6 @@ fn metadata(robot: &Robot, task: &Task, plan: &Plan) -> Metadata {
     Metadata { name: "a2ml".to_owned(), metadata: entries }
 }
 
-/// Every how many samples the arm's capsules are published, to stay at or below
-/// [`ARM_CAPSULE_RATE`].
-fn capsule_stride(rate: Real) -> usize {
-    let stride = (rate / ARM_CAPSULE_RATE).ceil();
-    if stride.is_finite() && stride >= 1.0 { stride as usize } else { 1 }
-}
-
 /// The segments in start order (stable for equal starts).
 fn by_start(segments: &[SegmentReport]) -> Vec<&SegmentReport> {
     let mut sorted: Vec<&SegmentReport> = segments.iter().collect();
@@ -161,7 +159,10 @@ pub(super) fn write<W: Write + Seek>(
     source: &str,
     plan: &Plan,
 ) -> Result<(), Failure> {
-    let mut writer = Writer::new(out)?;
+    // zstd on one thread: the compressed bytes then depend on the plan only, not on the
+    // machine's core count.
+    let options = WriteOptions::new().compression(Some(Compression::Zstd)).compression_threads(0);
+    let mut writer = options.create(out)?;
     attach(&mut writer, format!("{}.a2ml", task.name), "text/plain", source.as_bytes())?;
     attach(&mut writer, format!("{}.urdf", robot.name), "application/xml", robot.urdf.as_bytes())?;
     writer.write_metadata(&metadata(robot, task, plan))?;
@@ -172,7 +173,8 @@ pub(super) fn write<W: Write + Seek>(
     Ok(())
 }
 
-/// The messages published once, at the first sample: the obstacles and the wrist paths.
+/// The messages published once, at the first sample: the robot's URDF, the arm's capsules
+/// (attached to their links), the obstacles and the wrist paths.
 fn write_static<W: Write + Seek>(
     writer: &mut Writer<W>,
     topics: &mut Topics,
@@ -182,6 +184,9 @@ fn write_static<W: Write + Seek>(
 ) -> Result<(), Failure> {
     let nanos = Clock::of(plan).nanos(plan.trajectory.start());
     let time = Time::from_nanos(nanos);
+    let description = messages::robot_description(robot);
+    publish(writer, &mut topics.robot_description, nanos, &description)?;
+    publish(writer, &mut topics.arm_capsules, nanos, &messages::arm_capsules(time, robot))?;
     let scene = task.in_base_frame(&robot.structure.shoulder_in_base_link).scene;
     publish(writer, &mut topics.scene, nanos, &messages::obstacles(time, &scene))?;
     let planned: Vec<Vector3> =
@@ -200,20 +205,20 @@ fn write_samples<W: Write + Seek>(
 ) -> Result<(), Failure> {
     let clock = Clock::of(plan);
     let trajectory = &plan.trajectory;
-    let stride = capsule_stride(plan.rate);
-    let last = trajectory.len().saturating_sub(1);
     let mut segments = by_start(&plan.segments).into_iter().peekable();
     let mut series = StateSeries::default();
+    let (lower, upper) = (robot.lower(), robot.upper());
+    let limits = JointLimits { lower: &lower, upper: &upper };
     let samples =
         trajectory.times().iter().zip(trajectory.positions()).zip(trajectory.velocities());
-    for (i, ((&t, q), qd)) in samples.enumerate() {
+    for ((&t, q), qd) in samples {
         while let Some(segment) = segments.next_if(|s| s.start <= t) {
             write_segment(writer, &mut topics.segments, clock, segment)?;
         }
         let nanos = clock.nanos(t);
         let time = Time::from_nanos(nanos);
         let pose = arm_pose(robot, q);
-        let joints = messages::joint_state(time, &plan.joint_names, q, qd);
+        let joints = messages::joint_state(time, &plan.joint_names, q, qd, limits);
         publish(writer, &mut topics.joint_states, nanos, &joints)?;
         let names = robot.links.iter().map(|l| l.name.as_str());
         let tf = messages::frame_transforms(time, names.zip(link_poses(robot, &pose)));
@@ -221,10 +226,6 @@ fn write_samples<W: Write + Seek>(
         let (cpsa, hat) = (cpsa_state(robot, &pose).ok(), hat_state(&pose).ok());
         let state = messages::state(time, cpsa.as_ref(), hat.as_ref(), &mut series);
         publish(writer, &mut topics.state, nanos, &state)?;
-        if i % stride == 0 || i == last {
-            let capsules = messages::arm_capsules(time, &collision::arm_capsules(robot, &pose));
-            publish(writer, &mut topics.arm_capsules, nanos, &capsules)?;
-        }
     }
     for segment in segments {
         write_segment(writer, &mut topics.segments, clock, segment)?;
@@ -239,5 +240,5 @@ fn write_segment<W: Write + Seek>(
     segment: &SegmentReport,
 ) -> Result<(), Failure> {
     let nanos = clock.nanos(segment.start);
-    publish(writer, topic, nanos, &messages::segment(Time::from_nanos(nanos), segment))
+    publish(writer, topic, nanos, &messages::segment(Time::from_nanos(nanos), segment)?)
 }

@@ -3,11 +3,10 @@
 
 use serde::Serialize;
 
-use crate::collision::PosedCapsule;
 use crate::kinematics::{CpsaState, HatState};
 use crate::language::{Obstacle, Shape};
 use crate::math::{Isometry, JointVector, Real, Rotation3, UnitQuaternion, Vector3};
-use crate::robot::LinkRole;
+use crate::robot::{LinkRole, Robot};
 use crate::solve::SegmentReport;
 
 /// The frame every position is given in: {b}, origin at the shoulder centre.
@@ -106,6 +105,18 @@ pub(super) struct JointState<'a> {
     name: &'a [String],
     position: &'a [Real],
     velocity: &'a [Real],
+    lower: &'a [Real],
+    upper: &'a [Real],
+}
+
+/// The joint position limits (rad), repeated in every joint state so that a plot draws them
+/// beside the positions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct JointLimits<'a> {
+    /// Lower limits, in the order of q.
+    pub lower: &'a JointVector,
+    /// Upper limits.
+    pub upper: &'a JointVector,
 }
 
 /// The joint state of one sample.
@@ -114,14 +125,22 @@ pub(super) fn joint_state<'a>(
     names: &'a [String],
     q: &'a JointVector,
     qd: &'a JointVector,
+    limits: JointLimits<'a>,
 ) -> JointState<'a> {
-    JointState { timestamp: time, name: names, position: q.as_slice(), velocity: qd.as_slice() }
+    JointState {
+        timestamp: time,
+        name: names,
+        position: q.as_slice(),
+        velocity: qd.as_slice(),
+        lower: limits.lower.as_slice(),
+        upper: limits.upper.as_slice(),
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
 struct FrameTransform<'a> {
     timestamp: Time,
-    parent_frame_id: &'static str,
+    parent_frame_id: &'a str,
     child_frame_id: &'a str,
     translation: Xyz,
     rotation: Quaternion,
@@ -133,19 +152,27 @@ pub(super) struct FrameTransforms<'a> {
     transforms: Vec<FrameTransform<'a>>,
 }
 
-/// Each named frame's pose in {b} as a transform from frame "b".
+/// The links of a chain as a tree of transforms, as a URDF viewer expects them: the first
+/// link from frame "b", every other one from the link before it. `links` are the links' names
+/// and poses in {b}, base to tip.
 pub(super) fn frame_transforms<'a>(
     time: Time,
-    frames: impl IntoIterator<Item = (&'a str, Isometry)>,
+    links: impl IntoIterator<Item = (&'a str, Isometry)>,
 ) -> FrameTransforms<'a> {
-    let transforms = frames
+    let mut parent: (&str, Isometry) = (BASE_FRAME, Isometry::identity());
+    let transforms = links
         .into_iter()
-        .map(|(name, b_from_frame)| FrameTransform {
-            timestamp: time,
-            parent_frame_id: BASE_FRAME,
-            child_frame_id: name,
-            translation: (&b_from_frame.translation.vector).into(),
-            rotation: (&b_from_frame.rotation).into(),
+        .map(|(name, b_from_link)| {
+            let parent_from_link = parent.1.inv_mul(&b_from_link);
+            let transform = FrameTransform {
+                timestamp: time,
+                parent_frame_id: parent.0,
+                child_frame_id: name,
+                translation: (&parent_from_link.translation.vector).into(),
+                rotation: (&parent_from_link.rotation).into(),
+            };
+            parent = (name, b_from_link);
+            transform
         })
         .collect();
     FrameTransforms { transforms }
@@ -187,11 +214,11 @@ struct Line {
 /// Primitives a2ml does not draw; Foxglove's schema still requires their arrays.
 type Unused = [(); 0];
 
-/// `foxglove.SceneEntity`, in frame "b", kept until replaced.
+/// `foxglove.SceneEntity`, kept until replaced.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 struct SceneEntity {
     timestamp: Time,
-    frame_id: &'static str,
+    frame_id: String,
     id: String,
     lifetime: Time,
     frame_locked: bool,
@@ -207,10 +234,11 @@ struct SceneEntity {
 }
 
 impl SceneEntity {
+    /// An empty entity in frame "b".
     fn new(time: Time, id: String, metadata: Vec<KeyValue>) -> Self {
         Self {
             timestamp: time,
-            frame_id: BASE_FRAME,
+            frame_id: BASE_FRAME.to_owned(),
             id,
             lifetime: Time::ZERO,
             frame_locked: false,
@@ -317,10 +345,11 @@ fn role_color(role: LinkRole) -> Color {
     Color { r, g, b, a: 0.5 }
 }
 
-/// The arm's capsules at one sample, one entity each (ids stable across samples, so each
-/// message replaces the last).
-pub(super) fn arm_capsules(time: Time, capsules: &[PosedCapsule]) -> SceneUpdate {
-    let entities = capsules
+/// The arm's capsules, one entity each, in the frame of the link that carries it and locked
+/// to it: sent once, they move with that link's `/tf` transforms.
+pub(super) fn arm_capsules(time: Time, robot: &Robot) -> SceneUpdate {
+    let entities = robot
+        .capsules
         .iter()
         .enumerate()
         .map(|(i, c)| {
@@ -329,11 +358,35 @@ pub(super) fn arm_capsules(time: Time, capsules: &[PosedCapsule]) -> SceneUpdate
                 KeyValue { key: "role", value: c.role.as_str().to_owned() },
             ];
             let mut entity = SceneEntity::new(time, format!("capsule/{i}/{}", c.name), metadata);
-            add_capsule(&mut entity, &c.a, &c.b, c.radius, role_color(c.role));
+            // The capsule's ends are given in its moving frame; the entity is drawn in its link.
+            let link_from_frame = robot
+                .links
+                .iter()
+                .find(|l| l.name == c.link)
+                .map_or_else(Isometry::identity, |l| l.frame_from_link.inverse());
+            let (a, b) = (
+                link_from_frame.transform_point(&c.a.into()).coords,
+                link_from_frame.transform_point(&c.b.into()).coords,
+            );
+            entity.frame_id.clone_from(&c.link);
+            entity.frame_locked = true;
+            add_capsule(&mut entity, &a, &b, c.radius, role_color(c.role));
             entity
         })
         .collect();
     SceneUpdate { deletions: [], entities }
+}
+
+/// `/robot_description`: the URDF text in a `data` field, as ROS publishes it
+/// (`std_msgs/String`) and as Foxglove's 3D panel reads it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub(super) struct RobotDescription<'a> {
+    data: &'a str,
+}
+
+/// The robot's URDF document as a message.
+pub(super) fn robot_description(robot: &Robot) -> RobotDescription<'_> {
+    RobotDescription { data: &robot.urdf }
 }
 
 fn path_entity(time: Time, id: &str, points: &[Vector3], color: Color) -> SceneEntity {
@@ -374,11 +427,13 @@ struct Hat {
     ow: Quaternion,
 }
 
-/// `a2ml.State`: either space is null where its state is singular.
+/// `a2ml.State`: either space is left out where its state is singular.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub(super) struct State {
     timestamp: Time,
+    #[serde(skip_serializing_if = "Option::is_none")]
     cpsa: Option<Cpsa>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     hat: Option<Hat>,
 }
 
@@ -432,15 +487,22 @@ pub(super) fn state(
     State { timestamp: time, cpsa, hat }
 }
 
-/// `a2ml.Segment`: the report with its start time.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub(super) struct Segment<'a> {
-    timestamp: Time,
-    #[serde(flatten)]
-    report: &'a SegmentReport,
-}
+/// The fields of `a2ml.Segment` that a report may lack; left out of the message then.
+pub(super) const SEGMENT_OPTIONAL: [&str; 4] = ["action_type", "clearance", "rrt", "fallback"];
 
-/// The record of one segment.
-pub(super) fn segment(time: Time, report: &SegmentReport) -> Segment<'_> {
-    Segment { timestamp: time, report }
+/// `a2ml.Segment`: the report with its start time, its absent optional fields left out
+/// (Foxglove's schema reader takes one type per field, so "absent" stands for null).
+pub(super) fn segment(
+    time: Time,
+    report: &SegmentReport,
+) -> Result<serde_json::Value, serde_json::Error> {
+    let mut fields = serde_json::Map::new();
+    fields.insert("timestamp".to_owned(), serde_json::to_value(time)?);
+    if let serde_json::Value::Object(report) = serde_json::to_value(report)? {
+        let present = |(key, value): &(String, serde_json::Value)| {
+            !(value.is_null() && SEGMENT_OPTIONAL.contains(&key.as_str()))
+        };
+        fields.extend(report.into_iter().filter(present));
+    }
+    Ok(serde_json::Value::Object(fields))
 }

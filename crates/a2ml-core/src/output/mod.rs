@@ -1,5 +1,5 @@
-//! Writing a [`Plan`] to files (DESIGN.md §6): an MCAP recording for Foxglove, a CSV table of
-//! the joint trajectory, the plan as JSON, SVG pictures ([`plot`]) and an HTML report
+//! Writing a [`Plan`] to files (docs/design.md §6): an MCAP recording for Foxglove, a CSV table
+//! of the joint trajectory, the plan as JSON, SVG pictures ([`plot`]) and an HTML report
 //! ([`report`]).
 //!
 //! Entry points: [`write_mcap`], [`write_csv`], [`write_json`], [`plot::write_plot`],
@@ -32,21 +32,21 @@ pub use read::{
 pub use swivel_map::swivel_map_svg;
 
 use crate::language::Task;
-use crate::math::Real;
 use crate::robot::Robot;
 use crate::solve::Plan;
 
 /// The MCAP channels [`write_mcap`] writes, all JSON-encoded with a JSON Schema.
 pub mod topics {
-    /// `a2ml.JointState` per sample: timestamp, joint names, positions (rad), velocities (rad/s).
+    /// `a2ml.JointState` per sample: timestamp, joint names, positions (rad), velocities
+    /// (rad/s) and the position limits (rad), so that a plot shows each joint against them.
     pub const JOINT_STATES: &str = "/joint_states";
-    /// `foxglove.FrameTransforms` per sample: every link of the chain in frame "b".
+    /// `foxglove.FrameTransforms` per sample: the chain's links as a tree, the first link from
+    /// frame "b" and every other one from the link before it (as the URDF nests them).
     pub const TF: &str = "/tf";
     /// `foxglove.SceneUpdate` once at the start: the obstacles, in frame "b".
     pub const SCENE: &str = "/scene";
-    /// `foxglove.SceneUpdate` per sample (at most [`super::ARM_CAPSULE_RATE`]): the arm's
-    /// capsules. A topic of its own, so that the obstacles published once stay the latest
-    /// `/scene` message that Foxglove replays after a seek.
+    /// `foxglove.SceneUpdate` once at the start: the arm's capsules, each in its link's frame
+    /// and locked to it, so that `/tf` moves them.
     pub const ARM_CAPSULES: &str = "/arm_capsules";
     /// `foxglove.SceneUpdate` once: the planned and the reference wrist path Pw.
     pub const WRIST_PATH: &str = "/wrist_path";
@@ -54,11 +54,10 @@ pub mod topics {
     pub const STATE: &str = "/a2ml/state";
     /// `a2ml.Segment` at each segment's start: its [`crate::solve::SegmentReport`].
     pub const SEGMENTS: &str = "/a2ml/segments";
+    /// `std_msgs/String` once at the start: the robot's URDF in `data`, which Foxglove's 3D
+    /// panel draws (its visuals) on the `/tf` frames.
+    pub const ROBOT_DESCRIPTION: &str = "/robot_description";
 }
-
-/// Highest rate at which the arm's capsules are published (Hz): every sample up to this
-/// rate, every k-th sample above it.
-pub const ARM_CAPSULE_RATE: Real = 100.0;
 
 /// Why an output file could not be written. No partial file is left behind in any case.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -4,10 +4,13 @@
 //!
 //! Foxglove reads a JSON Schema into message definitions: every object needs `"type":
 //! "object"` and `properties`, a field has one type (no `["object", "null"]`, no `$ref`), and
-//! `oneOf` is only for numeric enumerations. Fields that may be null are therefore declared
-//! with their non-null type and say so in their description.
+//! `oneOf` is only for numeric enumerations. A field that may have no value is therefore
+//! declared with its one type, left out of `required`, and left out of the message when it
+//! has none: every message validates against its schema and Foxglove still reads the schema.
 
 use serde_json::{Value, json};
+
+use super::messages::SEGMENT_OPTIONAL;
 
 /// Schema name and body of a channel.
 pub(super) struct Schema {
@@ -285,7 +288,8 @@ pub(super) fn scene_update() -> Schema {
     Schema { name: "foxglove.SceneUpdate", body }
 }
 
-/// `a2ml.JointState`: the joint trajectory sample, laid out like ROS's sensor_msgs/JointState.
+/// `a2ml.JointState`: the joint trajectory sample, laid out like ROS's sensor_msgs/JointState,
+/// with the position limits beside it.
 pub(super) fn joint_state() -> Schema {
     let body = object(
         Some("a2ml.JointState"),
@@ -294,8 +298,18 @@ pub(super) fn joint_state() -> Schema {
             "name": array(typed("string")),
             "position": { "type": "array", "items": typed("number"), "description": "rad" },
             "velocity": { "type": "array", "items": typed("number"), "description": "rad/s" },
+            "lower": {
+                "type": "array",
+                "items": typed("number"),
+                "description": "lower position limits (rad)"
+            },
+            "upper": {
+                "type": "array",
+                "items": typed("number"),
+                "description": "upper position limits (rad)"
+            },
         }),
-        &["timestamp", "name", "position", "velocity"],
+        &["timestamp", "name", "position", "velocity", "lower", "upper"],
     );
     Schema { name: "a2ml.JointState", body }
 }
@@ -304,7 +318,7 @@ pub(super) fn joint_state() -> Schema {
 pub(super) fn state() -> Schema {
     let cpsa = json!({
         "type": "object",
-        "description": "CPSA state; null where it is singular (the arm straight or folded, \
+        "description": "CPSA state; absent where it is singular (the arm straight or folded, \
                         or the wrist on the vertical through S)",
         "properties": {
             "pw": xyz("foxglove.Vector3"),
@@ -315,7 +329,7 @@ pub(super) fn state() -> Schema {
     });
     let hat = json!({
         "type": "object",
-        "description": "HAT state; null where it is singular (the arm straight or folded)",
+        "description": "HAT state; absent where it is singular (the arm straight or folded)",
         "properties": {
             "shoulder_frame": quaternion(),
             "elbow_angle": described("number", "θe (rad)"),
@@ -326,7 +340,7 @@ pub(super) fn state() -> Schema {
     let body = object(
         Some("a2ml.State"),
         json!({ "timestamp": time(), "cpsa": cpsa, "hat": hat }),
-        &["timestamp", "cpsa", "hat"],
+        &["timestamp"],
     );
     Schema { name: "a2ml.State", body }
 }
@@ -344,38 +358,20 @@ pub(super) fn segment() -> Schema {
         json!({ "distance": n, "time": n, "link": s, "obstacle": s }),
         &["distance", "time", "link", "obstacle"],
     );
-    clearance["description"] = json!("smallest clearance (m) and where; null without obstacles");
-    let qp = object(
-        None,
-        json!({
-            "steps": i,
-            "clarabel_steps": i,
-            "mean_step_time": n,
-            "worst_step_time": n,
-            "median_fast_time": n,
-            "median_clarabel_time": n,
-        }),
-        &[
-            "steps",
-            "clarabel_steps",
-            "mean_step_time",
-            "worst_step_time",
-            "median_fast_time",
-            "median_clarabel_time",
-        ],
-    );
+    clearance["description"] = json!("smallest clearance (m) and where; absent without obstacles");
+    let qp = object(None, json!({ "steps": i, "clarabel_steps": i }), &["steps", "clarabel_steps"]);
     let mut rrt = object(
         None,
-        json!({ "samples": i, "nodes": i, "collision_checks": i, "time": described("number", "s") }),
-        &["samples", "nodes", "collision_checks", "time"],
+        json!({ "samples": i, "nodes": i, "collision_checks": i }),
+        &["samples", "nodes", "collision_checks"],
     );
-    rrt["description"] = json!("RRT counters when the RRT solved the segment; null otherwise");
+    rrt["description"] = json!("RRT counters when the RRT solved the segment; absent otherwise");
     let fields = json!({
         "timestamp": time(),
         "action": s,
         "action_index": i,
         "segment": i,
-        "action_type": described("string", "I to VII; null for explicit segments"),
+        "action_type": described("string", "I to VII; absent for explicit segments"),
         "space": described("string", "Cpsa or Hat"),
         "pattern": described("string", "Path (1), Goal (2) or Mixed (3)"),
         "solver": s,
@@ -397,7 +393,7 @@ pub(super) fn segment() -> Schema {
         "fallback": described(
             "string",
             "qp_stalled, qp_missed_goal or qp_left_path: why auto went on from the QP to the \
-             solver named; null if it did not"
+             solver named; absent if it did not"
         ),
            "peak_velocity_ratio": described("number", "largest |q'|/limit over the segment"),
         "peak_acceleration_ratio": described("number", "largest |q''|/limit over the segment"),
@@ -407,8 +403,21 @@ pub(super) fn segment() -> Schema {
         "wrist_jerk": described("number", "normalised jerk of the wrist path (dimensionless)"),
         "speed_peaks": described("integer", "peaks of the featured variable's speed"),
     });
-    let required: Vec<&str> =
-        fields.as_object().map(|m| m.keys().map(String::as_str).collect()).unwrap_or_default();
+    let required: Vec<&str> = fields
+        .as_object()
+        .map(|m| m.keys().map(String::as_str).filter(|k| !SEGMENT_OPTIONAL.contains(k)).collect())
+        .unwrap_or_default();
     let body = object(Some("a2ml.Segment"), fields.clone(), &required);
     Schema { name: "a2ml.Segment", body }
+}
+
+/// `std_msgs/String`, the type ROS publishes `/robot_description` with: the URDF text in
+/// `data`.
+pub(super) fn robot_description() -> Schema {
+    let body = object(
+        Some("std_msgs/String"),
+        json!({ "data": described("string", "the robot's URDF document") }),
+        &["data"],
+    );
+    Schema { name: "std_msgs/String", body }
 }

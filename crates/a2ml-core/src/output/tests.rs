@@ -5,10 +5,9 @@ use std::path::PathBuf;
 use super::atomic::{Failure, write_atomically};
 use super::messages::{self, QuaternionSeries, Time};
 use super::{OutputError, csv};
-use crate::collision::{self, PosedCapsule};
-use crate::kinematics::arm_pose;
-use crate::math::{PI, Real, Rotation3, UnitQuaternion, Vector3};
+use crate::math::{Isometry, PI, Real, Rotation3, UnitQuaternion, Vector3};
 use crate::robot::Robot;
+use nalgebra::Point3;
 
 /// An empty scratch folder of this test process.
 fn scratch(name: &str) -> PathBuf {
@@ -123,17 +122,20 @@ fn quaternions_stay_on_one_hemisphere() {
     }
 }
 
-/// One of COMAN's capsules, renamed "c" and moved to a-b with radius 5 cm.
-fn capsule(a: Vector3, b: Vector3) -> PosedCapsule {
-    let robot = Robot::from_urdf_file(concat!(
+/// COMAN with one capsule, "c", from `a` to `b` (in its moving frame) of radius 5 cm, and the
+/// transform from that frame to the capsule's link.
+fn one_capsule(a: Vector3, b: Vector3) -> (Robot, Isometry) {
+    let mut robot = Robot::from_urdf_file(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../robots/coman_right_arm.urdf"
     ))
     .expect("robot loads");
-    let pose = arm_pose(&robot, &robot.middle());
-    let mut c = collision::arm_capsules(&robot, &pose).swap_remove(0);
+    robot.capsules.truncate(1);
+    let c = &mut robot.capsules[0];
     (c.name, c.a, c.b, c.radius) = ("c".into(), a, b, 0.05);
-    c
+    let link = robot.links.iter().find(|l| l.name == c.link).expect("the capsule's link");
+    let link_from_frame = link.frame_from_link.inverse();
+    (robot, link_from_frame)
 }
 
 /// The orientation of a Foxglove pose.
@@ -143,44 +145,57 @@ fn orientation(pose: &serde_json::Value) -> UnitQuaternion {
     UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z))
 }
 
+fn position(pose: &serde_json::Value) -> Vector3 {
+    let p = &pose["position"];
+    let [x, y, z] = ["x", "y", "z"].map(|k| p[k].as_f64().expect("component"));
+    Vector3::new(x, y, z)
+}
+
 #[test]
-fn a_capsule_is_a_cylinder_along_its_axis_and_two_balls() {
+fn a_capsule_is_a_cylinder_along_its_axis_and_two_balls_in_its_link() {
     let (a, b) = (Vector3::new(0.1, 0.2, 0.3), Vector3::new(0.1, 0.5, 0.3));
-    let update = messages::arm_capsules(Time::from_nanos(0), &[capsule(a, b)]);
+    let (robot, link_from_frame) = one_capsule(a, b);
+    let update = messages::arm_capsules(Time::from_nanos(0), &robot);
     let json = serde_json::to_value(update).expect("json");
     let entity = &json["entities"][0];
     assert_eq!(entity["id"], "capsule/0/c");
-    assert_eq!(entity["frame_id"], "b");
-    assert_eq!(entity["spheres"].as_array().map(Vec::len), Some(2));
+    assert_eq!(entity["frame_id"], robot.capsules[0].link.as_str());
+    assert_eq!(entity["frame_locked"], true);
+    let caps = entity["spheres"].as_array().expect("caps");
+    assert_eq!(caps.len(), 2);
+    let (a_link, b_link) = (link_from_frame * Point3::from(a), link_from_frame * Point3::from(b));
+    assert!((position(&caps[0]["pose"]) - a_link.coords).norm() < 1e-12);
+    assert!((position(&caps[1]["pose"]) - b_link.coords).norm() < 1e-12);
     let cylinder = &entity["cylinders"][0];
     assert!((cylinder["size"]["z"].as_f64().expect("z") - 0.3).abs() < 1e-12);
     assert!((cylinder["size"]["x"].as_f64().expect("x") - 0.1).abs() < 1e-12);
-    assert!((cylinder["pose"]["position"]["y"].as_f64().expect("y") - 0.35).abs() < 1e-12);
-    // The pose's z axis is the capsule's axis (+y here).
+    let middle = 0.5 * (a_link.coords + b_link.coords);
+    assert!((position(&cylinder["pose"]) - middle).norm() < 1e-12);
+    // The pose's z axis is the capsule's axis.
     let q = orientation(&cylinder["pose"]);
-    assert!((q * Vector3::z() - Vector3::y()).norm() < 1e-12);
+    assert!((q * Vector3::z() - (b_link - a_link).normalize()).norm() < 1e-12);
 }
 
 #[test]
 fn a_capsule_pointing_down_and_a_ball_capsule_are_drawn() {
     let a = Vector3::new(0.0, 0.0, 0.2);
-    let down = messages::arm_capsules(Time::from_nanos(0), &[capsule(a, Vector3::zeros())]);
-    let json = serde_json::to_value(down).expect("json");
+    let (robot, link_from_frame) = one_capsule(a, Vector3::zeros());
+    let json =
+        serde_json::to_value(messages::arm_capsules(Time::from_nanos(0), &robot)).expect("json");
     let q = orientation(&json["entities"][0]["cylinders"][0]["pose"]);
-    assert!((q * Vector3::z() + Vector3::z()).norm() < 1e-12);
-    let ball = messages::arm_capsules(Time::from_nanos(0), &[capsule(a, a)]);
-    let json = serde_json::to_value(ball).expect("json");
+    let down = link_from_frame.rotation * -Vector3::z();
+    assert!((q * Vector3::z() - down).norm() < 1e-12);
+    let (ball, _) = one_capsule(a, a);
+    let json =
+        serde_json::to_value(messages::arm_capsules(Time::from_nanos(0), &ball)).expect("json");
     assert_eq!(json["entities"][0]["cylinders"].as_array().map(Vec::len), Some(0));
 }
 
 #[test]
-fn a_singular_state_is_null() {
+fn a_singular_state_is_left_out() {
     let state = messages::state(Time::from_nanos(0), None, None, &mut Default::default());
     let json = serde_json::to_value(state).expect("json");
-    assert_eq!(
-        json,
-        serde_json::json!({ "timestamp": { "sec": 0, "nsec": 0 }, "cpsa": null, "hat": null })
-    );
+    assert_eq!(json, serde_json::json!({ "timestamp": { "sec": 0, "nsec": 0 } }));
 }
 
 #[cfg(unix)]

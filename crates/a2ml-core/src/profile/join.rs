@@ -1,5 +1,5 @@
 //! Joining the joint trajectories of consecutive segments: the transitional connection +Tr
-//! (paper appendix A, eq. A.1) and the sequential connection +Se (DESIGN.md §4).
+//! (paper appendix A, eq. A.1) and the sequential connection +Se (docs/design.md §4).
 //!
 //! A trajectory is anything that gives joint positions and velocities at a time,
 //! `Fn(Real) -> JointSample`, each in its own time starting at 0. The joined trajectory is

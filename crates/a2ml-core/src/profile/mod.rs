@@ -1,5 +1,5 @@
 //! Bell speed profiles (eq. 9), reference paths, QP weight schedules and the joining of
-//! segments (appendix A), DESIGN.md §4-5.
+//! segments (appendix A), docs/design.md §4-5.
 //!
 //! Entry points: [`BellProfile`]; [`Reference`], built from a goal or a path feature and sampled
 //! as (value, velocity) at t; [`WeightSchedule`]; [`Transition`] with [`join_transitional`]

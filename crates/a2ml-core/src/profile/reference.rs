@@ -11,7 +11,7 @@ use crate::math::{
 const MIN_AXIS_NORM: Real = 1e-12;
 
 /// The shoulder frame Os and the hand frame Ow at the start of a primitive, in {b}: where the
-/// body axes r, l (Os columns 0, 1) and f, p (Ow columns 0, 1) are read (DESIGN.md §2-4).
+/// body axes r, l (Os columns 0, 1) and f, p (Ow columns 0, 1) are read (docs/design.md §2-4).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BodyFrames {
     /// Os = [r, l, r × l].

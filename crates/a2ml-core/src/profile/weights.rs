@@ -1,4 +1,4 @@
-//! Weights of the task components in the velocity QP (paper eq. 7, DESIGN.md §5).
+//! Weights of the task components in the velocity QP (paper eq. 7, docs/design.md §5).
 
 use crate::math::{PI, Real};
 

@@ -4,7 +4,7 @@
 //!
 //! Entry points: [`Robot::from_urdf_file`], [`Robot::from_urdf_str`].
 //! Every position of the model is in the base frame {b}: the axes of the
-//! chain's base link, the origin at the shoulder centre S (DESIGN.md §2).
+//! chain's base link, the origin at the shoulder centre S (docs/design.md §2).
 
 mod acceleration;
 mod capsules;

@@ -1,5 +1,5 @@
 //! Shoulder, elbow and wrist centres found from the joint axes at zero
-//! configuration (DESIGN.md §2).
+//! configuration (docs/design.md §2).
 
 use std::ops::Mul;
 

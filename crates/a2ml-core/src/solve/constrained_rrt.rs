@@ -1,4 +1,4 @@
-//! RRT-Connect in the constrained space of a pattern-3 segment (DESIGN.md §5, paper §5.3.2
+//! RRT-Connect in the constrained space of a pattern-3 segment (docs/design.md §5, paper §5.3.2
 //! and §6.2): the global solver for a segment whose path constraint must hold exactly while
 //! the arm finds its way round obstacles to the goals of the other variables.
 //!

@@ -1,4 +1,4 @@
-//! Solving the segments of a decomposed task (DESIGN.md §5) and the plan they make.
+//! Solving the segments of a decomposed task (docs/design.md §5) and the plan they make.
 //!
 //! Entry points: [`plan`] (a task to a [`Plan`]: trajectory and one [`SegmentReport`] per
 //! segment), [`qp::solve_segment`] (one segment with the velocity QP) and

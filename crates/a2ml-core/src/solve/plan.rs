@@ -576,7 +576,7 @@ impl Solver<'_> {
 
     /// Solves one segment with its solver: the override, else its own choice. `rrt` plans a
     /// goal segment (pattern 2) in joint space and a segment with a path (patterns 1 and 3) in
-    /// its constrained space. `auto` (DESIGN.md §5) gives a goal segment among obstacles to
+    /// its constrained space. `auto` (docs/design.md §5) gives a goal segment among obstacles to
     /// the RRT, falling back to the QP with a warning when the RRT finds no path; it gives a
     /// mixed segment (pattern 3) to the QP and, when the QP stalls, misses the goal or leaves
     /// a hard path, to the constrained RRT, keeping the QP's closest result with a warning

@@ -1,4 +1,4 @@
-//! The velocity QP of paper eq. 7 (DESIGN.md §5): one segment, one small QP per control step.
+//! The velocity QP of paper eq. 7 (docs/design.md §5): one segment, one small QP per control step.
 //!
 //! At each step the joint velocity q' minimises ½‖W(J q' - V)‖² + ½λ‖q'‖², J = J_cs or J_tr,
 //! V = reference velocity + gain × state error, subject to joint velocity bounds that brake

@@ -85,7 +85,8 @@ impl Fallback {
     }
 }
 
-/// Counters and timings of the velocity QP over one segment.
+/// Counters and timings of the velocity QP over one segment. The wall-clock timings are not
+/// serialised: plan files hold only what the same task and seed reproduce.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
 pub struct QpStats {
     /// Control steps taken.
@@ -94,13 +95,17 @@ pub struct QpStats {
     /// settle (see [`crate::solve::qp`]).
     pub clarabel_steps: usize,
     /// Mean wall time of a step (s): Jacobian, distances and the solve.
+    #[serde(skip_serializing)]
     pub mean_step_time: Real,
     /// Longest step (s).
+    #[serde(skip_serializing)]
     pub worst_step_time: Real,
     /// Median time of the steps solved without Clarabel (s): the weighted least-squares step,
     /// or the active-set step on it when a bound or row binds.
+    #[serde(skip_serializing)]
     pub median_fast_time: Real,
     /// Median time of the steps that needed Clarabel (s); 0 when none did.
+    #[serde(skip_serializing)]
     pub median_clarabel_time: Real,
 }
 

@@ -1,4 +1,4 @@
-//! RRT-Connect in joint space (DESIGN.md §5, paper §5.3.2): the global solver for goal
+//! RRT-Connect in joint space (docs/design.md §5, paper §5.3.2): the global solver for goal
 //! segments, finding a way round obstacles where the local QP stalls.
 //!
 //! Two trees grow towards uniform samples within the joint limits, one from the start and one
@@ -76,7 +76,8 @@ pub struct RrtStats {
     pub nodes: usize,
     /// Configurations checked for collision.
     pub collision_checks: usize,
-    /// Wall time (s).
+    /// Wall time (s); not serialised, so that plan files reproduce byte for byte.
+    #[serde(skip_serializing)]
     pub time: Real,
 }
 

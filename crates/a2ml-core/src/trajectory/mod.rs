@@ -1,5 +1,5 @@
 //! Sampled joint trajectories (time, q, q' per sample), their joining with +Tr blends and +Se
-//! (DESIGN.md §4, §5) and the checks run on the whole result: joint limits and clearance.
+//! (docs/design.md §4, §5) and the checks run on the whole result: joint limits and clearance.
 //!
 //! Entry points: [`Trajectory::new`], [`join_sequential`], [`join_transitional`],
 //! [`check_limits`], [`peaks`], [`min_clearance`], [`sample_times`] (the output grid),

@@ -1,7 +1,7 @@
 """Type stubs of the native module ``a2ml._a2ml`` (hand-written, checked by
 ``mypy.stubtest`` in ``make test``).
 
-Conventions (DESIGN.md §2-3): metres, radians; every position and rotation is
+Conventions (docs/design.md §2-3): metres, radians; every position and rotation is
 in the base frame {b}, whose origin is the shoulder centre S and whose axes
 are those of the URDF base link (z up). Array arguments accept any array-like
 of the stated shape and are converted to float64; a wrong shape or a NaN or
@@ -15,7 +15,7 @@ units: state variables are spelled as :class:`Robot` names them (``"pw"``,
 movement segments, returned in the same spelling (keys as in
 :class:`a2ml.Decomposition`). :func:`plan` solves them into a :class:`Plan`:
 the joint trajectory at the output rate, one :class:`SegmentReport` per
-segment, and the MCAP, CSV and JSON writers (DESIGN.md §6).
+segment, and the MCAP, CSV and JSON writers (docs/design.md §6).
 """
 
 import os
@@ -387,7 +387,7 @@ def load(path: str | os.PathLike[str]) -> Task:
     """
 
 def decompose(task: Task, robot: Robot | None = None) -> Decomposition:
-    """Decompose a task into movement segments (DESIGN.md §4).
+    """Decompose a task into movement segments (docs/design.md §4).
 
     The actions run in execution order (the STRIPS plan from ``init`` to
     ``goal``, or the written order) from the task's start configuration; each
@@ -623,10 +623,11 @@ class Plan:
         """The robot it was planned on."""
 
     def write_mcap(self, path: str | os.PathLike[str]) -> None:
-        """Write an MCAP file for Foxglove: ``/joint_states``, ``/tf``,
-        ``/scene``, ``/arm_capsules``, ``/wrist_path``, ``/a2ml/state`` and
-        ``/a2ml/segments``, JSON-encoded with JSON schemas, with the task
-        source and the URDF attached. Written to a temporary file and renamed,
+        """Write an MCAP file for Foxglove: ``/robot_description``,
+        ``/joint_states``, ``/tf``, ``/scene``, ``/arm_capsules``,
+        ``/wrist_path``, ``/a2ml/state`` and ``/a2ml/segments``, JSON-encoded
+        with JSON schemas in zstd chunks, with the task source and the URDF
+        attached; no wall-clock time, so the same plan gives the same bytes. Written to a temporary file and renamed,
         so a failure leaves no partial file. Releases the GIL.
 
         Raises:
@@ -704,7 +705,7 @@ def plan(
     acceleration_scale: float | None = None,
     time_limit: float | None = None,
 ) -> Plan:
-    """Plan a task (DESIGN.md §4-5): decompose it, solve every segment from
+    """Plan a task (docs/design.md §4-5): decompose it, solve every segment from
     where the last one really ended and join them (+Tr within an action, +Se
     between actions), resampled at ``rate``.
 

@@ -1,0 +1,139 @@
+//! Every shipped example does what its comments say: `check`, `explain` and `plan` on each,
+//! with the exit code its comment documents and, for the intended failures, the segment that
+//! fails and why. Outcomes only (exit codes, statuses), not numbers a solver change may move.
+
+use std::fs;
+use std::path::PathBuf;
+
+use crate::{a2ml, scratch, stderr, stdout};
+
+/// What an example's comments promise.
+struct Outcome {
+    /// The file in `examples/`.
+    file: &'static str,
+    /// Exit code of `a2ml explain`.
+    explain: i32,
+    /// Exit code of `a2ml plan`.
+    plan: i32,
+    /// Text that stderr of `a2ml plan` must hold: which action and segment failed and why.
+    plan_says: &'static [&'static str],
+}
+
+const fn ok(file: &'static str) -> Outcome {
+    Outcome { file, explain: 0, plan: 0, plan_says: &[] }
+}
+
+/// Every example and its documented outcome; `every_example_is_listed` keeps the list whole.
+const OUTCOMES: &[Outcome] = &[
+    ok("construct_action_options.a2ml"),
+    ok("construct_ascii_names.a2ml"),
+    ok("construct_comments.a2ml"),
+    ok("construct_explicit_segments.a2ml"),
+    ok("construct_frame_root.a2ml"),
+    ok("construct_goal.a2ml"),
+    ok("construct_goal_priority.a2ml"),
+    // "There is no default start": explain and plan stop with exit 2, saying so.
+    Outcome {
+        file: "construct_minimal.a2ml",
+        explain: 2,
+        plan: 2,
+        plan_says: &["task `reach` has no `start`"],
+    },
+    ok("construct_path_about.a2ml"),
+    ok("construct_path_by.a2ml"),
+    ok("construct_path_line.a2ml"),
+    ok("construct_path_soft.a2ml"),
+    ok("construct_scene.a2ml"),
+    ok("construct_sequence_se.a2ml"),
+    ok("construct_settings.a2ml"),
+    ok("construct_start_joints.a2ml"),
+    ok("construct_start_state.a2ml"),
+    ok("construct_start_state_hat.a2ml"),
+    ok("construct_strips.a2ml"),
+    ok("construct_units.a2ml"),
+    ok("push_box_aside_centauro.a2ml"),
+    ok("push_box_aside_coman.a2ml"),
+    // `auto` runs the QP, which leaves the line, then the constrained RRT, which keeps it.
+    ok("type_iv_forward_bar.a2ml"),
+    // The QP leaves the hard line to pass the bar: `off path`, the goal missed, exit 3.
+    Outcome {
+        file: "type_iv_lateral_bar.a2ml",
+        explain: 0,
+        plan: 3,
+        plan_says: &[
+            "action `rise_along_line`, segment 1: left its hard path",
+            "action `rise_along_line`, segment 1: missed",
+        ],
+    },
+    ok("type_vi_elbow_hold.a2ml"),
+    ok("type_vii_column.a2ml"),
+];
+
+fn examples_folder() -> PathBuf {
+    [env!("CARGO_MANIFEST_DIR"), "..", "..", "examples"].iter().collect()
+}
+
+#[test]
+fn every_example_is_listed() {
+    let mut found: Vec<String> = fs::read_dir(examples_folder())
+        .expect("examples/")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .filter(|name| name.ends_with(".a2ml"))
+        .collect();
+    found.sort_unstable();
+    let listed: Vec<&str> = OUTCOMES.iter().map(|o| o.file).collect();
+    assert_eq!(found, listed);
+}
+
+#[test]
+fn every_example_checks_explains_and_plans_as_documented() {
+    let dir = scratch("examples", "outcomes");
+    let mut types = std::collections::BTreeSet::new();
+    for outcome in OUTCOMES {
+        let file = examples_folder().join(outcome.file);
+        let file = file.to_string_lossy();
+        let check = a2ml(&["check", &file]);
+        assert_eq!(check.status.code(), Some(0), "check {}: {}", outcome.file, stderr(&check));
+
+        let explain = a2ml(&["explain", &file]);
+        assert_eq!(
+            explain.status.code(),
+            Some(outcome.explain),
+            "explain {}: {}",
+            outcome.file,
+            stderr(&explain)
+        );
+        for line in stdout(&explain).lines() {
+            if let Some(kind) = line.trim_start().strip_prefix("type ") {
+                types.insert(kind.split(':').next().unwrap_or_default().to_owned());
+            }
+        }
+
+        let mcap = dir.join(outcome.file.replace(".a2ml", ".mcap"));
+        let plan = a2ml(&["plan", &file, "-o", &mcap.to_string_lossy()]);
+        let (out, err) = (stdout(&plan), stderr(&plan));
+        assert_eq!(plan.status.code(), Some(outcome.plan), "plan {}: {out}\n{err}", outcome.file);
+        for says in outcome.plan_says {
+            assert!(err.contains(says), "plan {}: stderr lacks {says:?}:\n{err}", outcome.file);
+        }
+        // A plan that ends in 0 or 3 is written; one refused (2) writes nothing.
+        assert_eq!(mcap.exists(), matches!(outcome.plan, 0 | 3), "{}", outcome.file);
+        if outcome.plan == 0 {
+            // Every segment's status is `ok` (possibly with the solver that took over).
+            let rows: Vec<&str> = out
+                .lines()
+                .skip_while(|l| !l.trim_start().starts_with("action "))
+                .skip(1)
+                .take_while(|l| !l.is_empty())
+                .collect();
+            assert!(!rows.is_empty(), "plan {}: {out}", outcome.file);
+            for row in rows {
+                let ok = row.trim_end().ends_with("  ok") || row.contains("  ok (");
+                assert!(ok, "plan {}: a segment is not ok: {row}\n{err}", outcome.file);
+            }
+        }
+    }
+    // One example at least for each of the seven action types.
+    let all: Vec<String> = ["I", "II", "III", "IV", "V", "VI", "VII"].map(String::from).into();
+    assert_eq!(types.into_iter().collect::<Vec<_>>(), all);
+}
