@@ -58,7 +58,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             return Err(CliError::Io(format!("there is no folder {}", dir.display())));
         }
     }
-    let (task, source) = super::load_task(&args.file)?;
+    let (task, source) = super::load_task(&args.file, &a2ml_core::language::Limits::default())?;
     let robot = Robot::from_urdf_file(&task.robot)?;
     let options = PlanOptions::default();
     let attempts = compare(&robot, &task, &args.solvers, &options);

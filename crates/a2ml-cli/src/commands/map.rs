@@ -57,7 +57,7 @@ pub struct MapArgs {
 /// written; [`CliError::Input`] for an invalid task, action, segment or grid;
 /// [`CliError::Planning`] when the map cannot be built.
 pub fn run(args: &MapArgs) -> Result<(), CliError> {
-    let (task, _) = super::load_task(&args.file)?;
+    let (task, _) = super::load_task(&args.file, &a2ml_core::language::Limits::default())?;
     let robot = Robot::from_urdf_file(&task.robot)?;
     if args.segment == 0 {
         return Err(CliError::Input("--segment counts from 1".to_owned()));

@@ -70,7 +70,7 @@ pub struct Planned {
 /// # Errors
 /// As `a2ml plan`: [`CliError::Io`], [`CliError::Input`] or [`CliError::Planning`].
 pub fn plan_file(file: &Path, seed: Option<u64>) -> Result<Planned, CliError> {
-    let (mut task, source) = super::load_task(file)?;
+    let (mut task, source) = super::load_task(file, &a2ml_core::language::Limits::default())?;
     if let Some(seed) = seed {
         task.settings.seed = seed;
     }

@@ -28,9 +28,7 @@ use crate::decompose::{
     decompose, goal_error,
 };
 use crate::kinematics::{HatState, arm_pose, hat_to_cpsa, ik_cpsa};
-use crate::language::{
-    ActionBody, Limits, PrimitiveConstraint, SolverChoice, Space, Task, Variable,
-};
+use crate::language::{self, ActionBody, PrimitiveConstraint, SolverChoice, Space, Task, Variable};
 use crate::math::{DOF, JointVector, Real, Vector3};
 use crate::metrics::smoothness::{normalised_jerk, speed_peaks};
 use crate::profile::{BodyFrames, ProfileError, Reference, Role, Sample};
@@ -62,7 +60,7 @@ pub struct PlanOptions {
     /// on the machine's speed.
     pub time_limit: Option<Real>,
     /// How large a motion may be planned (samples, segments).
-    pub limits: Limits,
+    pub limits: language::Limits,
     /// A start (of the task or an action) closer to an obstacle than the safety distance is
     /// a warning rather than an error.
     pub allow_close_start: bool,
@@ -998,6 +996,7 @@ fn map_fits(job: &Job) -> bool {
             .components
             .iter()
             .all(|c| c.variable == Variable::Swivel || c.role == Role::Path)
+}
 
 /// The segment's featured variable: the first of its focus, else the wrist position.
 fn segment_focus(job: &Job) -> Variable {
