@@ -227,9 +227,9 @@ fn bad_settings_and_unavailable_solvers_are_errors() {
     let options = PlanOptions { rate: Some(0.0), ..PlanOptions::default() };
     assert!(matches!(plan(&robot, &task, &options), Err(SolveError::InvalidRate { .. })));
     let options =
-        PlanOptions { solver: Some(language::SolverChoice::Map), ..PlanOptions::default() };
-    let message = plan(&robot, &task, &options).expect_err("no map yet").to_string();
-    assert!(message.contains("solver `map` is not available yet"), "{message}");
+        PlanOptions { solver: Some(language::SolverChoice::Hamp), ..PlanOptions::default() };
+    let message = plan(&robot, &task, &options).expect_err("hamp plans goal segments only").to_string();
+    assert!(message.contains("solver `hamp` is not available yet"), "{message}");
 }
 
 #[test]

@@ -201,10 +201,15 @@ fn acceleration_limits_come_from_the_robot_file_or_the_default() {
     let default = coman.velocity_limits() * a2ml::robot::DEFAULT_ACCELERATION_PER_SECOND;
     assert_eq!(coman.acceleration_limits(), default);
     let text = std::fs::read_to_string(common::robot_path("panda")).expect("reads");
-    let bad = text.replacen("a2ml_acceleration=\"7.5\"", "a2ml_acceleration=\"fast\"", 1);
-    match Robot::from_urdf_str(&bad, &a2ml::RobotOptions::default()) {
+    // Not a number: the URDF reader's located error names the attribute.
+    let junk = text.replacen("a2ml_acceleration=\"7.5\"", "a2ml_acceleration=\"fast\"", 1);
+    let error = Robot::from_urdf_str(&junk, &a2ml::RobotOptions::default()).expect_err("junk");
+    assert!(error.to_string().contains("a2ml_acceleration"), "{error}");
+    // A number that is no acceleration limit.
+    let negative = text.replacen("a2ml_acceleration=\"7.5\"", "a2ml_acceleration=\"-3\"", 1);
+    match Robot::from_urdf_str(&negative, &a2ml::RobotOptions::default()) {
         Err(a2ml::RobotError::InvalidAcceleration { joint, text }) => {
-            assert_eq!((joint.as_str(), text.as_str()), ("panda_joint2", "fast"));
+            assert_eq!((joint.as_str(), text.as_str()), ("panda_joint2", "-3"));
         }
         other => panic!("{other:?}"),
     }

@@ -11,8 +11,8 @@ EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "baseline_pmp.a2ml"
 
 
 def test_compare_returns_flat_records() -> None:
-    records = a2ml.compare(EXAMPLE, solvers=["qp", "pmp", "map"])
-    assert [r["solver"] for r in records] == ["qp", "qp", "pmp", "pmp", "map"]
+    records = a2ml.compare(EXAMPLE, solvers=["qp", "pmp", "hamp"])
+    assert [r["solver"] for r in records] == ["qp", "qp", "pmp", "pmp", "hamp"]
     pmp = records[2]
     assert pmp["solved_by"] == "pmp" and pmp["action"] == "out_diagonal"
     assert isinstance(pmp["error_Pw"], float) and pmp["error_Pw"] < 1e-3

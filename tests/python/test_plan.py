@@ -232,7 +232,7 @@ def test_solver_overrides_the_task_and_its_actions() -> None:
 
 def test_unavailable_solver_raises() -> None:
     with pytest.raises(PlanError, match="not available yet") as info:
-        a2ml.plan(EXAMPLE, solver="map")
+        a2ml.plan(EXAMPLE, solver="hamp")
     assert isinstance(info.value, a2ml.A2mlError)
     assert "slide_left" in str(info.value)
 

@@ -16,7 +16,7 @@ fn compare_prints_one_row_per_solver_and_segment_and_writes_each_plan() {
         assert!(dir.join(name).is_file(), "{name} missing");
     }
 
-    let output = a2ml(&["compare", &task, "--solvers", "pmp,map", "--json"]);
+    let output = a2ml(&["compare", &task, "--solvers", "pmp,hamp", "--json"]);
     assert_eq!(output.status.code(), Some(0));
     let records: serde_json::Value = serde_json::from_str(&stdout(&output)).expect("JSON");
     let records = records.as_array().expect("a list");
@@ -25,5 +25,5 @@ fn compare_prints_one_row_per_solver_and_segment_and_writes_each_plan() {
     assert_eq!(records[0]["solved_by"], "pmp");
     assert!(records[0]["errors"]["Pw"].as_f64().expect("Pw error") < 1e-3);
     assert!(records[0]["limit_joint"].is_string() && records[0]["peak_speed_ratio"].is_number());
-    assert!(records[2]["error"].as_str().expect("map fails").contains("not available yet"));
+    assert!(records[2]["error"].as_str().expect("hamp fails on a path").contains("not available yet"));
 }

@@ -190,11 +190,11 @@ fn unavailable_solver_exits_2() {
     let dir = scratch("plan", "unavailable_solver");
     let mcap = path_in(&dir, "out.mcap");
     let task = example_path("construct_path_line.a2ml");
-    let output = a2ml(&["plan", &task, "--solver", "map", "-o", &mcap]);
+    let output = a2ml(&["plan", &task, "--solver", "hamp", "-o", &mcap]);
     assert_eq!(output.status.code(), Some(2));
     let err = stderr(&output);
     assert!(err.starts_with("error: ") && err.lines().count() == 1, "{err}");
-    assert!(err.contains("action `slide_left`: solver `map` is not available yet"), "{err}");
+    assert!(err.contains("action `slide_left`: solver `hamp` is not available yet"), "{err}");
     assert!(listing(&dir).is_empty());
 
     let output = a2ml(&["plan", &task, "--solver", "fast"]);

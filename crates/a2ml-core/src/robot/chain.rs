@@ -187,6 +187,10 @@ impl<'a> Tree<'a> {
 /// that every angle has a 2π shift inside it with room to move past ±π.
 pub(crate) const CONTINUOUS_RANGE: Real = 2.0 * PI;
 
+/// The widest joint range a2ml plans: two turns (a continuous joint's window), with room for
+/// a URDF that writes ±2π to four decimals.
+const MAX_RANGE: Real = 2.0 * CONTINUOUS_RANGE + 1e-3;
+
 /// A joint's limits; its acceleration limit from the robot file's `a2ml_acceleration`
 /// attribute or the default.
 fn limits(joint: &super::urdf::Joint) -> Result<JointLimits, RobotError> {
@@ -206,6 +210,18 @@ fn limits(joint: &super::urdf::Joint) -> Result<JointLimits, RobotError> {
             lower: l.lower,
             upper: l.upper,
             velocity: l.velocity,
+        });
+    }
+    // Every 2π shift of an angle within the range is an IK candidate, so a range of many turns
+    // would multiply the branches per joint (and a hostile file could ask for millions).
+    if upper - lower > MAX_RANGE {
+        return Err(RobotError::Urdf {
+            path: None,
+            message: format!(
+                "line {}, <joint name=\"{}\">: its range [{lower}, {upper}] rad spans more than \
+                 two turns (4π rad), which a2ml does not plan",
+                joint.line, joint.name
+            ),
         });
     }
     let acceleration =

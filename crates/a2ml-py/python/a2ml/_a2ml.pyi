@@ -736,7 +736,7 @@ def plan(
 
 def compare(
     task_or_path: Task | str | os.PathLike[str],
-    solvers: list[Literal["auto", "qp", "rrt", "map", "gpm", "clik", "pmp"]] | None = None,
+    solvers: list[Literal["auto", "qp", "rrt", "map", "gpm", "clik", "pmp", "hamp"]] | None = None,
     robot: Robot | None = None,
 ) -> list[dict[str, Any]]:
     """Plan one task with each of ``solvers`` (default ``auto``, ``gpm``,
