@@ -33,6 +33,7 @@ __all__ = [
     "parse",
     "load",
     "compare",
+    "swivel_map",
     "decompose",
     "plan",
     "Plan",
