@@ -10,6 +10,7 @@
 //! Their long loops report progress and check the user's wall-clock limit through a
 //! [`monitor::Monitor`]; without a limit, results never depend on the clock.
 
+mod assembly;
 mod checks;
 pub mod clik;
 pub mod compare;

@@ -10,6 +10,7 @@
 
 use std::time::Instant;
 
+use super::assembly::Assembly;
 use super::checks::{self, CheckError};
 use super::constrained_rrt::{Chart, constrained_rrt_monitored, time_constrained};
 use super::control::{BaselineOptions, ControlError, ControlOptions, ControlRun};
@@ -502,20 +503,26 @@ impl Solver<'_> {
     /// returns the trajectory and a note per shortened blend.
     fn join_all(&mut self) -> Result<(Trajectory, Vec<String>), SolveError> {
         let mut notes = Vec::new();
-        let mut whole: Option<Trajectory> = None;
+        // Each join only changes the samples from its seam on, so only the tail is rebuilt:
+        // joining stays linear in the number of segments.
+        let mut whole = Assembly::default();
         let mut i = 0;
         while i < self.pieces.len() {
             let action = self.pieces[i].action;
-            let action_start = whole.as_ref().map_or(0.0, Trajectory::end);
-            let mut joined: Option<Trajectory> = None;
+            let action_start = whole.end().unwrap_or(0.0);
+            let mut joined = Assembly::default();
             let mut last: Option<(Real, Real)> = None; // (start, duration) of the previous segment
             while i < self.pieces.len() && self.pieces[i].action == action {
                 let segment = self.pieces[i].timed();
                 let duration = segment.duration();
-                let (start, next) = match (joined.take(), last) {
-                    (Some(before), Some((prev_start, prev_duration))) => {
+                let start = match last {
+                    Some((prev_start, prev_duration)) => {
                         let overlap = self.task.settings.transition * prev_duration.min(duration);
-                        let (next, used) = self.blend(&before, &segment, overlap)?;
+                        let used = joined
+                            .join_with(&segment, overlap, |before, next| {
+                                self.blend(before, next, overlap)
+                            })?
+                            .unwrap_or(0.0);
                         if used < overlap {
                             let r = &self.pieces[i].report;
                             notes.push(format!(
@@ -527,23 +534,22 @@ impl Solver<'_> {
                                 overlap
                             ));
                         }
-                        (prev_start + prev_duration - used, next)
+                        prev_start + prev_duration - used
                     }
-                    _ => (action_start, shifted(&segment, action_start)?),
+                    None => {
+                        joined.join_sequential(&shifted(&segment, action_start)?)?;
+                        action_start
+                    }
                 };
-                joined = Some(next);
                 last = Some((start, duration));
                 self.pieces[i].start = start;
                 i += 1;
             }
-            if let Some(action_trajectory) = joined {
-                whole = Some(match whole.take() {
-                    Some(before) => trajectory::join_sequential(&before, &action_trajectory)?,
-                    None => action_trajectory,
-                });
+            if let Some(action_trajectory) = joined.finish()? {
+                whole.join_sequential(&action_trajectory)?;
             }
         }
-        let whole = whole.ok_or(TrajectoryError::Empty)?;
+        let whole = whole.finish()?.ok_or(TrajectoryError::Empty)?;
         Ok((whole, notes))
     }
 
