@@ -14,9 +14,9 @@ use super::assembly::Assembly;
 use super::checks::{self, CheckError};
 use super::constrained_rrt::{Chart, constrained_rrt_monitored, time_constrained};
 use super::control::{BaselineOptions, ControlError, ControlOptions, ControlRun};
+use super::hamp::{HampOptions, HandoverTarget, plan_handover};
 use super::map::{MapError, MapOptions, map_segment};
 use super::monitor::{Monitor, deadline_after};
-use super::hamp::{HampOptions, HandoverTarget, plan_handover};
 use super::qp::{self, Component, QpError, QpOptions, SegmentProblem};
 use super::report::{Fallback, Plan, QpStats, SegmentReport, VariableError};
 use super::rrt::{
@@ -738,26 +738,7 @@ impl Solver<'_> {
                 segment: job.k,
                 source,
             })?;
-        let trajectory = profile.trajectory;
-        let end = trajectory.positions().last().copied().unwrap_or(self.q);
-        let errors = end_errors(self.robot, &job.problem, &end);
-        let tolerance = &self.options.qp.tolerance;
-        let reached =
-            job.problem.components.iter().zip(errors).all(|(c, e)| e <= tolerance.of(c.variable));
-        let (path_errors, path_kept) = self.assess(job, &trajectory);
-        Ok(Solved {
-            solver: SolverChoice::Map,
-            trajectory,
-            errors,
-            path_errors,
-            path_kept,
-            settle: 0.0,
-            reached,
-            stalled: false,
-            qp: QpStats::default(),
-            rrt: None,
-            fallback: None,
-        })
+        Ok(self.judged(job, SolverChoice::Map, profile.trajectory, 0.0, false, None))
     }
 
     /// A segment by one of the baselines, judged like every other solver: the segment's own
@@ -779,32 +760,14 @@ impl Solver<'_> {
         let run = solve(self.robot, &job.problem, &self.q, o, &control).map_err(|source| {
             SolveError::Baseline { action: job.action.name.clone(), segment: job.k, solver, source }
         })?;
-        let end = run.trajectory.positions().last().copied().unwrap_or(self.q);
-        let errors = end_errors(self.robot, &job.problem, &end);
-        let tolerance = &self.options.qp.tolerance;
-        let reached =
-            job.problem.components.iter().zip(errors).all(|(c, e)| e <= tolerance.of(c.variable));
-        let (path_errors, path_kept) = self.assess(job, &run.trajectory);
-        Ok(Solved {
-            solver,
-            trajectory: run.trajectory,
-            errors,
-            path_errors,
-            path_kept,
-            settle: run.settle,
-            reached,
-            stalled: run.stalled,
-            qp: QpStats::default(),
-            rrt: None,
-            fallback: None,
-        })
-
+        Ok(self.judged(job, solver, run.trajectory, run.settle, run.stalled, None))
     }
 
     /// A goal segment by the HAMP handover planner towards its end state: the pick-up
     /// patterns, timed by Fitts' law (METHODS.md §3.4).
     fn hamp(&mut self, job: &Job) -> Result<Solved, SolveError> {
-        let failed = |source| SolveError::Hamp { action: job.action.name.clone(), segment: job.k, source };
+        let failed =
+            |source| SolveError::Hamp { action: job.action.name.clone(), segment: job.k, source };
         let goal = ArmState::at(self.robot, &job.segment.end)
             .map_err(|e| failed(super::hamp::HampError::Target(e)))?;
         let target =
@@ -814,13 +777,12 @@ impl Solver<'_> {
             rate: 1.0 / self.options.qp.step,
             ..HampOptions::default()
         };
-        let planned = plan_handover(self.robot, &self.q, &target, job.scene, &options).map_err(failed)?;
+        let planned =
+            plan_handover(self.robot, &self.q, &target, job.scene, &options).map_err(failed)?;
         if !planned.limit_violations.is_empty() {
             self.notes.push(format!("{}: the hamp motion exceeds a joint speed limit", job.name()));
         }
-        let duration = planned.duration;
-        let timed = TimedPath { trajectory: planned.trajectory, duration, stretched: false };
-        Ok(Solved { solver: SolverChoice::Hamp, rrt: None, ..self.timed(job, timed, RrtStats::default()) })
+        Ok(self.judged(job, SolverChoice::Hamp, planned.trajectory, 0.0, false, None))
     }
 
     fn rrt_options(&self) -> RrtOptions {
@@ -842,23 +804,37 @@ impl Solver<'_> {
                 job.segment.duration
             ));
         }
-        let end = timed.trajectory.positions().last().copied().unwrap_or(self.q);
+        self.judged(job, SolverChoice::Rrt, timed.trajectory, 0.0, false, Some(stats))
+    }
+
+    /// A solver's trajectory judged on the segment's own terms, whichever solver made it:
+    /// the end's goal errors against the tolerances, and how far it kept its paths.
+    fn judged(
+        &self,
+        job: &Job,
+        solver: SolverChoice,
+        trajectory: Trajectory,
+        settle: Real,
+        stalled: bool,
+        rrt: Option<RrtStats>,
+    ) -> Solved {
+        let end = trajectory.positions().last().copied().unwrap_or(self.q);
         let errors = end_errors(self.robot, &job.problem, &end);
         let tolerance = &self.options.qp.tolerance;
         let reached =
             job.problem.components.iter().zip(errors).all(|(c, e)| e <= tolerance.of(c.variable));
-        let (path_errors, path_kept) = self.assess(job, &timed.trajectory);
+        let (path_errors, path_kept) = self.assess(job, &trajectory);
         Solved {
-            solver: SolverChoice::Rrt,
-            trajectory: timed.trajectory,
+            solver,
+            trajectory,
             errors,
             path_errors,
             path_kept,
-            settle: 0.0,
+            settle,
             reached,
-            stalled: false,
+            stalled,
             qp: QpStats::default(),
-            rrt: Some(stats),
+            rrt,
             fallback: None,
         }
     }
