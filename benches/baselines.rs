@@ -1,7 +1,7 @@
 //! Per-step cost of the baselines next to the QP's: the same 1.2 s wrist line on COMAN (the
 //! segment of benches/plan.rs `qp/segment_free`) solved whole by each solver; one step costs
 //! the segment's time divided by the steps printed. GPM, CLIK and PMP integrate with RK4 (four
-//! resolver calls a step), the QP with Euler; `*/resolve` times one call of each formula.
+//! resolver calls a step), the QP with its trapezoidal ramp (one QP a step); `*/resolve` times one call of each formula.
 
 use std::hint::black_box;
 
@@ -84,13 +84,13 @@ fn baselines(c: &mut Criterion) {
     let mut p =
         pmp::Pmp::new(&robot, &q0, goal, problem.duration, &options.pmp, tolerance).expect("pmp");
     group.bench_function("gpm/resolve", |b| {
-        b.iter(|| g.resolve(&arm_pose(&robot, &q0), black_box(&q0), 0.3))
+        b.iter(|| g.resolve(&arm_pose(&robot, &q0), black_box(&q0), &JointVector::zeros(), 0.3))
     });
     group.bench_function("clik/resolve", |b| {
-        b.iter(|| k.resolve(&arm_pose(&robot, &q0), black_box(&q0), 0.3))
+        b.iter(|| k.resolve(&arm_pose(&robot, &q0), black_box(&q0), &JointVector::zeros(), 0.3))
     });
     group.bench_function("pmp/resolve", |b| {
-        b.iter(|| p.resolve(&arm_pose(&robot, &q0), black_box(&q0), 0.3))
+        b.iter(|| p.resolve(&arm_pose(&robot, &q0), black_box(&q0), &JointVector::zeros(), 0.3))
     });
     group.finish();
 }

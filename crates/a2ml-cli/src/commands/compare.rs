@@ -63,7 +63,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
     let options = PlanOptions::default();
     let attempts = compare(&robot, &task, &args.solvers, &options);
     let rows: Vec<ComparisonRecord> = attempts.iter().flat_map(|a| records(&robot, a)).collect();
-    output::emit(&rows, args.json, &[], || table(&rows, &options.qp.tolerance))?;
+    output::emit(&rows, args.json, &[], || table(&rows, &options.tolerance))?;
     if let Some(dir) = &args.output {
         let stem = args.file.file_stem().map_or_else(|| "plan".into(), |s| s.to_string_lossy());
         for attempt in &attempts {

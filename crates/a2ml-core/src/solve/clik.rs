@@ -16,7 +16,7 @@
 use super::control::{
     ControlError, ControlOptions, ControlRun, HandReference, Resolved, Resolver, run,
 };
-use super::qp::SegmentProblem;
+use super::problem::SegmentProblem;
 use super::report::Tolerance;
 use crate::kinematics::{ArmPose, arm_pose, geometric_jacobian, point_jacobian};
 use crate::math::{DOF, Jacobian3x7, JointVector, Matrix3, Matrix7, Real, Vector3, skew};
@@ -188,10 +188,13 @@ impl Clik {
 }
 
 impl Resolver for Clik {
+    type Error = ControlError;
+
     fn resolve(
         &mut self,
         pose: &ArmPose,
         q: &JointVector,
+        _velocity: &JointVector,
         t: Real,
     ) -> Result<Resolved, ControlError> {
         let o = &self.options;

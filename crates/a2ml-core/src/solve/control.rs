@@ -1,12 +1,14 @@
 //! The velocity-level control loop every resolver-based solver shares: measure, reference,
 //! step, integrate, settle, stall, brake.
 //!
-//! A [`Resolver`] maps the arm's configuration and the segment time to a joint velocity q'
-//! (its formula: a baseline's pseudo-inverse, later the QP) and says how far its task is from
-//! done; [`run`] integrates it on a fixed grid (explicit Euler or RK4), runs past the segment's
-//! duration until the task is reached and the arm at rest, stops when progress stalls, and
-//! brakes to rest when it stops while moving, so the next action starts from rest. The hand
-//! references the baselines follow ([`HandReference`]) are built here from a segment.
+//! A [`Resolver`] maps the arm's configuration, its velocity and the segment time to a joint
+//! velocity q' (its formula: the velocity QP's step, a baseline's pseudo-inverse) and says how
+//! far its task is from done; [`run`] integrates it on a fixed grid (trapezoidal, explicit
+//! Euler or RK4), runs past the segment's duration until the task is reached and the arm at
+//! rest, stops when progress stalls, and brakes to rest when it stops while moving (the
+//! resolver holding where it stopped, or q' decaying), so the next action starts from rest.
+//! The hand references the baselines follow ([`HandReference`]) are built here from a
+//! segment.
 
 use std::time::Instant;
 
@@ -14,8 +16,9 @@ use nalgebra::SVector;
 
 use super::clik::ClikOptions;
 use super::gpm::GpmOptions;
+use super::monitor::Monitor;
 use super::pmp::PmpOptions;
-use super::qp::SegmentProblem;
+use super::problem::SegmentProblem;
 use super::report::Tolerance;
 use crate::decompose::ArmState;
 use crate::kinematics::{ArmPose, arm_pose};
@@ -32,7 +35,12 @@ pub type Vector6 = SVector<Real, 6>;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Integration {
-    /// q ← q + h q'(q, t): one resolver call per step (the QP's, whose bounds are not smooth).
+    /// The velocity ramps linearly over the step from the arm's velocity to the resolver's
+    /// answer, q ← q + h (q'₀ + q')/2: one resolver call per step, and the samples (q and
+    /// the velocity at the step's start) are one piecewise-quadratic motion. The QP's, whose
+    /// answer is bounded by the acceleration limits around the velocity the arm has.
+    Trapezoid,
+    /// q ← q + h q'(q, t): one resolver call per step.
     Euler,
     /// Classical Runge-Kutta: four calls per step, O(h⁴), so that a resolver that tracks its
     /// task exactly in continuous time does so on the grid to far below a micrometre.
@@ -117,6 +125,12 @@ pub enum ControlError {
         /// What is wrong.
         reason: &'static str,
     },
+    /// The wall-clock limit set by the user passed.
+    #[error("timeout at t = {time:.3} s: the time limit passed")]
+    Timeout {
+        /// Segment time (s).
+        time: Real,
+    },
     /// The resolver's task Jacobian lost rank where the arm is.
     #[error("at t = {time:.3} s the {what} is singular")]
     Singular {
@@ -152,26 +166,55 @@ pub struct Resolved {
 /// A velocity-level solver: the formula that maps the arm's configuration to q'.
 ///
 /// A resolver holds its robot, its references and any state of its own (CLIK's layers, PMP's
-/// clock); the loop owns q and time. It may be called at any t ≥ 0 within a step (RK4 calls
-/// it at t, t + h/2 and t + h), and past the segment's duration while the loop settles.
+/// clock, the QP's solver); the loop owns q, the arm's velocity and time. It may be called at
+/// any t ≥ 0 within a step (RK4 calls it at t, t + h/2 and t + h), and past the segment's
+/// duration while the loop settles.
 pub trait Resolver {
-    /// q' at configuration `q` (FK already done: `pose`) and segment time `t`, with the task
-    /// error there.
+    /// What a resolver's step can fail with; the loop's own errors convert into it.
+    type Error: From<ControlError>;
+
+    /// q' at configuration `q` (FK already done: `pose`), where the arm moves at `velocity`,
+    /// at segment time `t`, with the task error there.
     ///
     /// # Errors
-    /// [`ControlError::Singular`] where its formula needs an inverse that does not exist.
+    /// Where its formula has no answer (for the baselines [`ControlError::Singular`], where
+    /// an inverse does not exist).
     fn resolve(
         &mut self,
         pose: &ArmPose,
         q: &JointVector,
+        velocity: &JointVector,
         t: Real,
-    ) -> Result<Resolved, ControlError>;
+    ) -> Result<Resolved, Self::Error>;
 
     /// An upper bound of the closed loop's fastest rate (1/s) near `pose`, for RK4's
     /// substeps; 0 (the default) when the control step is always small enough.
     fn fastest_rate(&self, pose: &ArmPose) -> Real {
         let _ = pose;
         0.0
+    }
+
+    /// The number whose fall the loop watches while settling, to tell a stall (by default
+    /// the task error of `resolved`).
+    fn progress(&self, resolved: &Resolved) -> Real {
+        resolved.error
+    }
+
+    /// Switches the resolver to holding the state at `pose`, where the loop stopped while the
+    /// arm moves at `velocity`, on a grid of `step` (s); then the loop runs it, from time 0,
+    /// for at most the steps returned or until the arm is at rest. `None` (the default): the
+    /// loop brakes on its own, q' decaying at [`ControlOptions::brake_rate`].
+    ///
+    /// # Errors
+    /// When the state cannot be held.
+    fn hold(
+        &mut self,
+        pose: &ArmPose,
+        velocity: &JointVector,
+        step: Real,
+    ) -> Result<Option<usize>, Self::Error> {
+        let _ = (pose, velocity, step);
+        Ok(None)
     }
 }
 
@@ -212,60 +255,94 @@ fn check_options(o: &ControlOptions) -> Result<(), ControlError> {
 /// Integrates `resolver` from `q0` over a segment of `duration` (s), then settles and brakes.
 ///
 /// Steps land exactly on the duration; settling continues on the same grid until the task is
-/// reached with the arm at rest, its error stalls, or `max_settle` runs out. A run that stops
-/// while moving brakes (q' decaying at `brake_rate`) until at rest.
+/// reached with the arm at rest, its progress stalls, or `max_settle` runs out. A run that
+/// stops while moving brakes until at rest: the resolver holds the state it reached
+/// ([`Resolver::hold`]), or q' decays at `brake_rate`.
 ///
 /// # Errors
-/// [`ControlError`]: invalid settings, a resolver error, or non-finite samples.
+/// [`ControlError`] (as the resolver's error): invalid settings, a resolver error, or
+/// non-finite samples.
 pub fn run<R: Resolver>(
     robot: &Robot,
     resolver: &mut R,
     q0: &JointVector,
     duration: Real,
     options: &ControlOptions,
-) -> Result<ControlRun, ControlError> {
+) -> Result<ControlRun, R::Error> {
+    run_monitored(robot, resolver, q0, duration, options, &mut Monitor::silent())
+}
+
+/// Control steps between two progress reports and deadline checks.
+const REPORT_EVERY: usize = 64;
+
+/// [`run`], reporting the fraction of the duration done to `monitor` and stopping at its
+/// deadline ([`ControlError::Timeout`]).
+///
+/// # Errors
+/// As [`run`].
+pub fn run_monitored<R: Resolver>(
+    robot: &Robot,
+    resolver: &mut R,
+    q0: &JointVector,
+    duration: Real,
+    options: &ControlOptions,
+    monitor: &mut Monitor,
+) -> Result<ControlRun, R::Error> {
     check_options(options)?;
     if !(duration.is_finite() && duration > 0.0) {
-        return Err(ControlError::InvalidOptions { reason: "the duration must be positive" });
+        return Err(ControlError::InvalidOptions { reason: "the duration must be positive" }.into());
     }
     let steps = (duration / options.step).ceil().max(1.0) as usize;
     let h = duration / steps as Real;
     let settle_steps = (options.max_settle / h).ceil() as usize;
     let window = ((options.stall_window / h).ceil() as usize).max(1);
     let ramp = options.start_ramp;
-    let call = |resolver: &mut R, q: &JointVector, t: Real| {
-        let mut resolved = resolver.resolve(&arm_pose(robot, q), q, t)?;
+    let call = |resolver: &mut R, q: &JointVector, velocity: &JointVector, t: Real| {
+        let mut resolved = resolver.resolve(&arm_pose(robot, q), q, velocity, t)?;
         if t < ramp {
             resolved.velocity *= 0.5 * (1.0 - (std::f64::consts::PI * t / ramp).cos());
         }
-        Ok::<Resolved, ControlError>(resolved)
+        Ok::<Resolved, R::Error>(resolved)
     };
 
     let (mut times, mut positions, mut velocities) = (Vec::new(), Vec::new(), Vec::new());
     let mut progress: Vec<Real> = Vec::new();
     let mut q = *q0;
+    // The arm's velocity at the step's start; each segment starts at rest.
+    let mut velocity = JointVector::zeros();
     let mut k = 0;
     let mut wall = 0.0;
     let (reached, stalled) = loop {
         let started = Instant::now();
         let t = k as Real * h;
-        let now = call(resolver, &q, t)?;
+        if k % REPORT_EVERY == 0 {
+            if monitor.expired() {
+                return Err(ControlError::Timeout { time: t }.into());
+            }
+            monitor.report(t / duration.max(h));
+        }
+        let now = call(resolver, &q, &velocity, t)?;
+        if options.integration != Integration::Trapezoid {
+            velocity = now.velocity;
+        }
         times.push(t);
         positions.push(q);
-        velocities.push(now.velocity);
+        velocities.push(velocity);
         if k >= steps {
             let reached = now.error <= 1.0;
-            let at_rest = now.velocity.amax() <= options.rest_speed;
-            progress.push(now.error);
+            let at_rest = velocity.amax().max(now.velocity.amax()) <= options.rest_speed;
+            let score = resolver.progress(&now);
+            progress.push(score);
             let n = progress.len();
-            let stuck = n > window
-                && progress[n - 1 - window] - now.error <= options.stall_fraction * now.error;
+            let stuck =
+                n > window && progress[n - 1 - window] - score <= options.stall_fraction * score;
             if (reached && at_rest) || stuck || k >= steps + settle_steps {
                 wall += started.elapsed().as_secs_f64();
                 break (reached, !reached && stuck);
             }
         }
         q = match options.integration {
+            Integration::Trapezoid => q + (velocity + now.velocity) * (0.5 * h),
             Integration::Euler => q + now.velocity * h,
             Integration::Rk4 => {
                 // Substeps keep RK4 inside its stability region (|rate · step| ≤ 1 < 2.78).
@@ -275,24 +352,51 @@ pub fn run<R: Resolver>(
                 let mut p = q;
                 for i in 0..n {
                     let s = t + i as Real * d;
-                    let k1 = if i == 0 { now.velocity } else { call(resolver, &p, s)?.velocity };
-                    let k2 = call(resolver, &(p + k1 * (d / 2.0)), s + d / 2.0)?.velocity;
-                    let k3 = call(resolver, &(p + k2 * (d / 2.0)), s + d / 2.0)?.velocity;
-                    let k4 = call(resolver, &(p + k3 * d), s + d)?.velocity;
+                    let v = velocity;
+                    let k1 = if i == 0 { now.velocity } else { call(resolver, &p, &v, s)?.velocity };
+                    let k2 = call(resolver, &(p + k1 * (d / 2.0)), &v, s + d / 2.0)?.velocity;
+                    let k3 = call(resolver, &(p + k2 * (d / 2.0)), &v, s + d / 2.0)?.velocity;
+                    let k4 = call(resolver, &(p + k3 * d), &v, s + d)?.velocity;
                     p += (k1 + (k2 + k3) * 2.0 + k4) * (d / 6.0);
                 }
                 p
             }
         };
+        velocity = now.velocity;
         if q.iter().any(|x| !x.is_finite()) {
-            return Err(TrajectoryError::NonFinite { what: "position", sample: k + 1 }.into());
+            let error = TrajectoryError::NonFinite { what: "position", sample: k + 1 };
+            return Err(ControlError::from(error).into());
         }
         wall += started.elapsed().as_secs_f64();
         k += 1;
     };
     let taken = times.len();
-    brake(&mut times, &mut positions, &mut velocities, h, options);
-    let trajectory = Trajectory::new(times, positions, velocities)?;
+    if velocity.amax() > options.rest_speed {
+        match resolver.hold(&arm_pose(robot, &q), &velocity, h)? {
+            Some(most) => {
+                // The resolver holds the state reached: its own steps bring the arm to rest.
+                let start = *times.last().unwrap_or(&0.0);
+                let mut t = start;
+                for _ in 0..most {
+                    let now = call(resolver, &q, &velocity, t - start)?;
+                    q = match options.integration {
+                        Integration::Trapezoid => q + (velocity + now.velocity) * (0.5 * h),
+                        _ => q + now.velocity * h,
+                    };
+                    velocity = now.velocity;
+                    t += h;
+                    times.push(t);
+                    positions.push(q);
+                    velocities.push(velocity);
+                    if velocity.amax() <= options.rest_speed {
+                        break;
+                    }
+                }
+            }
+            None => brake(&mut times, &mut positions, &mut velocities, h, options),
+        }
+    }
+    let trajectory = Trajectory::new(times, positions, velocities).map_err(ControlError::from)?;
     Ok(ControlRun {
         settle: (trajectory.duration() - duration).max(0.0),
         trajectory,
@@ -440,10 +544,13 @@ mod tests {
     }
 
     impl Resolver for Decay {
+        type Error = ControlError;
+
         fn resolve(
             &mut self,
             _: &ArmPose,
             q: &JointVector,
+            _: &JointVector,
             _: Real,
         ) -> Result<Resolved, ControlError> {
             let e = self.goal - q;

@@ -9,7 +9,7 @@ use super::control::{
     ControlError, ControlOptions, ControlRun, HandReference, Resolved, Resolver, Vector6,
     hand_goal, pose_error, pose_error_score, run,
 };
-use super::qp::SegmentProblem;
+use super::problem::SegmentProblem;
 use super::report::Tolerance;
 use crate::kinematics::{ArmPose, geometric_jacobian};
 use crate::math::{Jacobian6x7, JointVector, Real};
@@ -96,10 +96,13 @@ impl Gpm {
 }
 
 impl Resolver for Gpm {
+    type Error = ControlError;
+
     fn resolve(
         &mut self,
         pose: &ArmPose,
         q: &JointVector,
+        _velocity: &JointVector,
         t: Real,
     ) -> Result<Resolved, ControlError> {
         let jacobian = geometric_jacobian(pose);

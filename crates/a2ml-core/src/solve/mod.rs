@@ -11,6 +11,7 @@
 //! [`monitor::Monitor`]; without a limit, results never depend on the clock.
 
 mod assembly;
+pub mod chart;
 mod checks;
 pub mod clik;
 pub mod compare;
@@ -18,13 +19,17 @@ pub mod constrained_rrt;
 pub mod control;
 pub mod gpm;
 pub mod hamp;
+pub mod judge;
 pub mod map;
 pub mod monitor;
 pub(crate) mod plan;
 pub mod pmp;
+pub mod problem;
 pub mod qp;
 mod report;
 pub mod rrt;
+pub mod timing;
+mod tree;
 
 pub use checks::CheckError;
 pub use monitor::Monitor;

@@ -12,16 +12,18 @@ use std::time::Instant;
 
 use super::assembly::Assembly;
 use super::checks::{self, CheckError};
-use super::constrained_rrt::{Chart, constrained_rrt_monitored, time_constrained};
+use super::chart::Chart;
+use super::constrained_rrt::constrained_rrt_monitored;
 use super::control::{BaselineOptions, ControlError, ControlOptions, ControlRun};
 use super::hamp::{HampOptions, HandoverTarget, plan_handover};
 use super::map::{MapError, MapOptions, map_segment};
 use super::monitor::{Monitor, deadline_after};
-use super::qp::{self, Component, QpError, QpOptions, SegmentProblem};
-use super::report::{Fallback, Plan, QpStats, SegmentReport, VariableError};
-use super::rrt::{
-    RrtError, RrtOptions, RrtStats, TimedPath, rrt_connect_monitored, time_parameterise,
-};
+use super::judge::{self, Judgement};
+use super::problem::{Component, SegmentProblem};
+use super::qp::{self, QpError, QpOptions};
+use super::report::{Fallback, Plan, QpStats, SegmentReport, Tolerance, VariableError};
+use super::rrt::{RrtError, RrtOptions, RrtStats, rrt_connect_monitored};
+use super::timing::{TimedPath, time_constrained, time_parameterise};
 use super::{clik, gpm, pmp};
 use crate::collision::CollisionScene;
 use crate::decompose::{
@@ -37,17 +39,28 @@ use crate::robot::Robot;
 use crate::trajectory::{self, Limits, Trajectory, TrajectoryError, peaks};
 
 /// Settings of [`plan`].
-#[derive(Debug, Clone, Default)]
+///
+/// The settings every solver shares are fields of their own ([`PlanOptions::tolerance`],
+/// [`PlanOptions::safety_distance`]); `plan` gives them to each solver, replacing the
+/// solver's own copy (`qp.tolerance`, `qp.safety_distance`, `rrt.clearance`, ...), which
+/// only a solver called on its own uses.
+#[derive(Debug, Clone)]
 pub struct PlanOptions {
+    /// When a goal counts as reached and a path as kept, for every solver; default 1 mm, 1°.
+    pub tolerance: Tolerance,
+    /// d_s, the distance every solver keeps from obstacles and between non-adjacent links
+    /// (m), default 0.01: the QP's damper rows, the RRTs' clearance, the swivel map's free
+    /// cells, and the start checks.
+    pub safety_distance: Real,
     /// The decomposition (Opt1/Opt2, action planner, default durations).
     pub decompose: DecomposeOptions,
-    /// The velocity QP.
+    /// The velocity QP (its tolerance and safety distance come from the plan's).
     pub qp: QpOptions,
-    /// RRT-Connect (its seed and clearance come from the task and `qp.safety_distance`).
+    /// RRT-Connect (its seed comes from the task, its clearance is the safety distance).
     pub rrt: RrtOptions,
-    /// The swivel map (its safety distance comes from `qp.safety_distance`).
+    /// The swivel map (its safety distance is the plan's).
     pub map: MapOptions,
-    /// The baselines GPM, CLIK and PMP and their control loop.
+    /// The baselines GPM, CLIK and PMP and their control loop (its tolerance is the plan's).
     pub baselines: BaselineOptions,
     /// Solver for every segment, overriding the task and its actions.
     pub solver: Option<SolverChoice>,
@@ -65,6 +78,27 @@ pub struct PlanOptions {
     /// A start (of the task or an action) closer to an obstacle than the safety distance is
     /// a warning rather than an error.
     pub allow_close_start: bool,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        let qp = QpOptions::default();
+        Self {
+            tolerance: qp.tolerance,
+            safety_distance: qp.safety_distance,
+            decompose: DecomposeOptions::default(),
+            qp,
+            rrt: RrtOptions::default(),
+            map: MapOptions::default(),
+            baselines: BaselineOptions::default(),
+            solver: None,
+            rate: None,
+            acceleration_scale: None,
+            time_limit: None,
+            limits: language::Limits::default(),
+            allow_close_start: false,
+        }
+    }
 }
 
 /// How far planning has got, for progress displays: `done` whole segments, then `fraction`
@@ -247,7 +281,7 @@ pub fn plan_with_progress(
         &decomposition,
         rate,
         1.0 / options.qp.step,
-        options.qp.safety_distance,
+        options.safety_distance,
         &options.limits,
         options.allow_close_start,
     )?;
@@ -256,7 +290,12 @@ pub fn plan_with_progress(
         robot,
         task: &task_b,
         options,
-        qp: QpOptions { acceleration_scale: scale, ..options.qp },
+        qp: QpOptions {
+            acceleration_scale: scale,
+            tolerance: options.tolerance,
+            safety_distance: options.safety_distance,
+            ..options.qp
+        },
         limits: Limits::of(robot).with_acceleration_scale(scale),
         deadline,
         rate,
@@ -286,7 +325,7 @@ pub fn plan_with_progress(
         wrist_reference.extend(piece.reference.iter().map(|(t, p)| (piece.start + t, *p)));
         segments.push(piece.report);
     }
-    let safety = options.qp.safety_distance;
+    let safety = options.safety_distance;
     warnings.extend(segments.iter().filter_map(|s| checks::too_close(s, safety)));
     warnings.extend(segments.iter().filter(|s| !s.reached).map(missed));
     warnings.extend(segments.iter().filter(|s| !s.path_kept).map(left_path));
@@ -298,7 +337,7 @@ pub fn plan_with_progress(
         trajectory: whole,
         segments,
         wrist_reference,
-        safety_distance: options.qp.safety_distance,
+        safety_distance: options.safety_distance,
         warnings,
     })
 }
@@ -338,7 +377,7 @@ struct Solver<'a> {
     robot: &'a Robot,
     task: &'a Task,
     options: &'a PlanOptions,
-    /// The QP's options with the plan's acceleration scale.
+    /// The QP's options with the plan's acceleration scale, tolerance and safety distance.
     qp: QpOptions,
     /// The limits every output holds.
     limits: Limits,
@@ -675,7 +714,14 @@ impl Solver<'_> {
             segment: job.k,
             source,
         })?;
-        let (path_errors, path_kept) = self.assess(job, &solution.trajectory);
+        let (path_errors, path_kept) = judge::path_errors(
+            self.robot,
+            &job.problem,
+            &job.chart,
+            job.hard,
+            &solution.trajectory,
+            &self.options.tolerance,
+        );
         Ok(Solved {
             solver: SolverChoice::Qp,
             trajectory: solution.trajectory,
@@ -729,7 +775,7 @@ impl Solver<'_> {
     fn map(&mut self, job: &Job) -> Result<Solved, SolveError> {
         let obstacles = self.task.action_scene(job.action.index);
         let options = MapOptions {
-            safety_distance: self.options.qp.safety_distance,
+            safety_distance: self.options.safety_distance,
             ..self.options.map.clone()
         };
         let (_, profile) = map_segment(self.robot, &obstacles, &job.problem, &self.q, &options)
@@ -756,7 +802,7 @@ impl Solver<'_> {
         ) -> Result<ControlRun, ControlError>,
     ) -> Result<Solved, SolveError> {
         let o = &self.options.baselines;
-        let control = ControlOptions { tolerance: self.options.qp.tolerance, ..o.control };
+        let control = ControlOptions { tolerance: self.options.tolerance, ..o.control };
         let run = solve(self.robot, &job.problem, &self.q, o, &control).map_err(|source| {
             SolveError::Baseline { action: job.action.name.clone(), segment: job.k, solver, source }
         })?;
@@ -788,7 +834,7 @@ impl Solver<'_> {
     fn rrt_options(&self) -> RrtOptions {
         RrtOptions {
             seed: self.task.settings.seed,
-            clearance: self.options.qp.safety_distance,
+            clearance: self.options.safety_distance,
             ..self.options.rrt
         }
     }
@@ -807,8 +853,8 @@ impl Solver<'_> {
         self.judged(job, SolverChoice::Rrt, timed.trajectory, 0.0, false, Some(stats))
     }
 
-    /// A solver's trajectory judged on the segment's own terms, whichever solver made it:
-    /// the end's goal errors against the tolerances, and how far it kept its paths.
+    /// A solver's trajectory judged on the segment's own terms, whichever solver made it
+    /// ([`judge::judge`]).
     fn judged(
         &self,
         job: &Job,
@@ -818,12 +864,15 @@ impl Solver<'_> {
         stalled: bool,
         rrt: Option<RrtStats>,
     ) -> Solved {
-        let end = trajectory.positions().last().copied().unwrap_or(self.q);
-        let errors = end_errors(self.robot, &job.problem, &end);
-        let tolerance = &self.options.qp.tolerance;
-        let reached =
-            job.problem.components.iter().zip(errors).all(|(c, e)| e <= tolerance.of(c.variable));
-        let (path_errors, path_kept) = self.assess(job, &trajectory);
+        let Judgement { errors, reached, path_errors, path_kept } = judge::judge(
+            self.robot,
+            &job.problem,
+            &job.chart,
+            job.hard,
+            &trajectory,
+            &self.options.tolerance,
+            &self.q,
+        );
         Solved {
             solver,
             trajectory,
@@ -839,24 +888,6 @@ impl Solver<'_> {
         }
     }
 
-    /// The largest distance of each path component from its path over the trajectory, and
-    /// whether a hard path was kept within tolerance.
-    fn assess(&self, job: &Job, trajectory: &Trajectory) -> ([Real; 3], bool) {
-        let tolerance = &self.options.qp.tolerance;
-        let mut worst = [0.0; 3];
-        for q in trajectory.positions() {
-            let Ok(state) = ArmState::at(self.robot, q) else {
-                return ([Real::INFINITY; 3], !job.hard);
-            };
-            for (w, e) in worst.iter_mut().zip(job.chart.deviation(&state, tolerance)) {
-                *w = Real::max(*w, e);
-            }
-        }
-        let within =
-            job.problem.components.iter().zip(worst).all(|(c, e)| e <= tolerance.of(c.variable));
-        (worst, within || !job.hard)
-    }
-
     /// The segment's reference Pw at the output rate, in its own time.
     fn reference(&self, problem: &SegmentProblem) -> Vec<(Real, Vector3)> {
         trajectory::sample_times(0.0, problem.duration, self.rate)
@@ -868,11 +899,11 @@ impl Solver<'_> {
     /// The segment's report as solved, in its own time; [`complete`] adds what joining
     /// decides and the measures of the output.
     fn report(&self, job: &Job, solution: &Solved) -> SegmentReport {
-        let tolerance = &self.options.qp.tolerance;
+        let tolerance = &self.options.tolerance;
         let error = |variable: Variable, error: Real| VariableError {
             variable,
             error,
-            within: error <= tolerance.of(variable),
+            within: judge::within(tolerance, variable, error),
         };
         let components = job.problem.components.iter();
         let errors = components.clone().zip(solution.errors).map(|(c, e)| error(c.variable, e));
@@ -1060,13 +1091,6 @@ struct Solved {
     rrt: Option<RrtStats>,
     /// Why `auto` went on from the QP to this solver.
     fallback: Option<Fallback>,
-}
-
-/// Each component's error at configuration `q` against its reference's end: distance for
-/// Pw, geodesic angle for rotations, (wrapped) angle difference.
-fn end_errors(robot: &Robot, problem: &SegmentProblem, q: &JointVector) -> [Real; 3] {
-    let Ok(state) = ArmState::at(robot, q) else { return [Real::INFINITY; 3] };
-    problem.components.map(|c| goal_error(&state, &[(c.variable, c.reference.end())]))
 }
 
 /// The trajectory with `offset` added to its times.

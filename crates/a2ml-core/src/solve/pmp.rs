@@ -19,7 +19,7 @@ use super::control::{
     ControlError, ControlOptions, ControlRun, Resolved, Resolver, hand_goal, pose_error,
     pose_error_score, run,
 };
-use super::qp::SegmentProblem;
+use super::problem::SegmentProblem;
 use super::report::Tolerance;
 use crate::kinematics::{ArmPose, arm_pose, geometric_jacobian};
 use crate::math::{DOF, JointVector, Real, Rotation3, Vector3};
@@ -225,10 +225,13 @@ pub fn task_jacobian(task: PmpTask, pose: &ArmPose) -> DMatrix<Real> {
 }
 
 impl Resolver for Pmp {
+    type Error = ControlError;
+
     fn resolve(
         &mut self,
         pose: &ArmPose,
         q: &JointVector,
+        _velocity: &JointVector,
         t: Real,
     ) -> Result<Resolved, ControlError> {
         let error = self.task_error(pose);

@@ -9,9 +9,11 @@
 //! (verified by the KKT conditions); Clarabel solves the steps where they do not. Clarabel is
 //! used here only.
 //!
-//! The arm's velocity does not jump to each step's answer: the answer is bounded by the
-//! acceleration limits around the velocity the arm has (a box within the velocity box), and
-//! the velocity ramps to it over the step, so q is integrated by the trapezoidal rule and the
+//! The QP is a [`Resolver`] of the shared control loop ([`super::control`]), which settles,
+//! detects stalls and brakes (by holding the state reached). The arm's velocity does not jump
+//! to each step's answer: the answer is bounded by the acceleration limits around the
+//! velocity the arm has (a box within the velocity box), and the velocity ramps to it over
+//! the step, so q is integrated by the trapezoidal rule ([`Integration::Trapezoid`]) and the
 //! samples' q and q' are one piecewise-quadratic motion whose acceleration is within the
 //! limits. Where that box and an obstacle's damper row cannot both hold, the step keeps the
 //! damper (safety first) and the acceleration check of the plan catches the rest.
@@ -23,11 +25,17 @@ use clarabel::solver::{
     DefaultSettings, DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
 
+use super::control::{
+    ControlError, ControlOptions, Integration, Resolved, Resolver, run_monitored,
+};
+use super::judge;
 use super::monitor::Monitor;
+use super::problem::width;
+pub use super::problem::{Component, SegmentProblem};
 use super::report::{QpStats, Tolerance};
 use crate::collision::{self, CollisionScene, DistanceOptions, Proximity};
 use crate::kinematics::{
-    ArmPose, KinematicsError, arm_pose, cpsa_jacobian, cpsa_state, hat_jacobian, hat_state,
+    ArmPose, KinematicsError, cpsa_jacobian, cpsa_state, hat_jacobian, hat_state,
     point_jacobian,
 };
 use crate::language::{Space, Target, Variable};
@@ -136,28 +144,20 @@ pub enum QpError {
     /// The samples do not make a trajectory (non-finite values).
     #[error(transparent)]
     Trajectory(#[from] TrajectoryError),
+    /// The control loop refused its settings or its run.
+    #[error(transparent)]
+    Control(ControlError),
 }
 
-/// One state variable of a segment: what it follows and how it is weighted.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Component {
-    /// The variable.
-    pub variable: Variable,
-    /// Its reference over the segment.
-    pub reference: Reference,
-    /// Goal (scheduled weight) or path (constant weight).
-    pub role: Role,
-}
-
-/// A segment for the QP: the three components of one space, in [`Space::variables`] order.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SegmentProblem {
-    /// CPSA or HAT.
-    pub space: Space,
-    /// One component per variable of the space, in its order.
-    pub components: [Component; 3],
-    /// The references' duration T (s).
-    pub duration: Real,
+impl From<ControlError> for QpError {
+    fn from(e: ControlError) -> Self {
+        match e {
+            ControlError::InvalidOptions { reason } => QpError::InvalidOptions { reason },
+            ControlError::Timeout { time } => QpError::Timeout { time },
+            ControlError::Trajectory(e) => QpError::Trajectory(e),
+            e => QpError::Control(e),
+        }
+    }
 }
 
 /// A solved segment.
@@ -194,9 +194,6 @@ pub fn solve_segment(
     solve_segment_monitored(robot, scene, problem, q0, options, &mut Monitor::silent())
 }
 
-/// Control steps between two progress reports and deadline checks.
-const REPORT_EVERY: usize = 64;
-
 /// [`solve_segment`], reporting the fraction of the reference's time done to `monitor` and
 /// stopping at its deadline ([`QpError::Timeout`]).
 ///
@@ -211,92 +208,34 @@ pub fn solve_segment_monitored(
     monitor: &mut Monitor,
 ) -> Result<QpSolution, QpError> {
     check_options(options)?;
-    let mut controller = Controller::new(robot, scene, problem, options);
-    let h = options.step;
-    let total = problem.duration;
-    // Steps land exactly on T; the settle phase continues on the same grid.
-    let steps = (total / h).ceil().max(1.0) as usize;
-    let h_ref = total / steps as Real;
-    let settle_steps = (options.max_settle / h_ref).ceil() as usize;
-    let window = ((0.2 / h_ref).ceil() as usize).max(1);
-
-    let mut times = Vec::with_capacity(steps + 1);
-    let mut positions = Vec::with_capacity(steps + 1);
-    let mut velocities = Vec::with_capacity(steps + 1);
-    let mut progress: Vec<Real> = Vec::new();
-    let mut max_errors = [0.0; 3];
-    let mut q = *q0;
-    // The arm's velocity at the step's start; each segment starts at rest.
-    let mut velocity = JointVector::zeros();
-    let mut k = 0;
-    let (errors, stalled) = loop {
-        let t = k as Real * h_ref;
-        if k % REPORT_EVERY == 0 {
-            if monitor.expired() {
-                return Err(QpError::Timeout { time: t });
-            }
-            monitor.report(t / total.max(h_ref));
-        }
-        let step = controller.step(&q, &velocity, t)?;
-        for (m, e) in max_errors.iter_mut().zip(step.errors) {
-            *m = Real::max(*m, e);
-        }
-        times.push(t);
-        positions.push(q);
-        velocities.push(velocity);
-        if k >= steps {
-            // Settling on the goal: stop at rest within tolerance, when progress stalls, or
-            // when the time is up.
-            let reached = controller.within(&step.errors);
-            let at_rest = velocity.amax().max(step.velocity.amax()) <= options.rest_speed;
-            let score = controller.score(&step.errors);
-            progress.push(score);
-            let n = progress.len();
-            let stuck = n > window && progress[n - 1 - window] - score <= 0.01 * score;
-            if (reached && at_rest) || stuck || k >= steps + settle_steps {
-                break (step.errors, !reached && stuck);
-            }
-        }
-        // The velocity ramps to the step's answer: the trapezoidal rule is exact.
-        q += (velocity + step.velocity) * (0.5 * h_ref);
-        velocity = step.velocity;
-        k += 1;
-    };
-    if velocity.amax() > options.rest_speed {
-        // Stopped short while still moving: hold the state reached until the arm is at rest,
-        // so the next action can start from rest. Braking takes as long as the acceleration
-        // limits ask, at most the settle time plus that.
-        let hold = controller.hold_problem(&q, options.max_settle.max(h_ref))?;
-        let mut brake = Controller::new(robot, scene, &hold, options);
-        let start = *times.last().unwrap_or(&0.0);
-        let braking = (velocity.component_div(&brake.acceleration).amax() / h_ref).ceil() as usize;
-        let mut t = start;
-        for _ in 0..settle_steps.max(1) + braking {
-            let step = brake.step(&q, &velocity, t - start)?;
-            q += (velocity + step.velocity) * (0.5 * h_ref);
-            velocity = step.velocity;
-            t += h_ref;
-            times.push(t);
-            positions.push(q);
-            velocities.push(velocity);
-            if velocity.amax() <= options.rest_speed {
-                break;
-            }
-        }
-        controller.timing.merge(brake.timing);
-    }
-    let trajectory = Trajectory::new(times, positions, velocities)?;
-    let settle = (trajectory.duration() - total).max(0.0);
-    let reached = controller.within(&errors);
+    let mut controller = Controller::new(robot, scene, problem.clone(), options);
+    let run = run_monitored(robot, &mut controller, q0, problem.duration, &control_options(options), monitor)?;
+    let errors = controller.errors;
     Ok(QpSolution {
-        trajectory,
+        trajectory: run.trajectory,
         errors,
-        max_errors,
-        settle,
-        reached,
-        stalled,
+        max_errors: controller.max_errors,
+        settle: run.settle,
+        reached: judge::reached(&options.tolerance, &problem.components, &errors),
+        stalled: run.stalled,
         stats: controller.timing.stats(),
     })
+}
+
+/// The control loop the QP runs on: its step, settle time, rest speed and tolerance; a stall
+/// is a fall of less than 1 % in 0.2 s, as for every resolver.
+fn control_options(o: &QpOptions) -> ControlOptions {
+    ControlOptions {
+        step: o.step,
+        integration: Integration::Trapezoid,
+        max_settle: o.max_settle,
+        rest_speed: o.rest_speed,
+        // Unused: the QP brakes by holding the state it reached.
+        brake_rate: 0.5 / o.step,
+        start_ramp: 0.0,
+        tolerance: o.tolerance,
+        ..ControlOptions::default()
+    }
 }
 
 fn check_options(o: &QpOptions) -> Result<(), QpError> {
@@ -331,11 +270,13 @@ struct Step {
     errors: [Real; 3],
 }
 
-/// Everything that stays the same over a segment's steps.
+/// The QP as a resolver: what stays the same over a segment's steps, the solver it sets up
+/// once, and what it measured.
 struct Controller<'a> {
     robot: &'a Robot,
     scene: &'a CollisionScene,
-    problem: &'a SegmentProblem,
+    /// The segment's problem; once the loop stops while moving, the hold of where it stopped.
+    problem: SegmentProblem,
     options: &'a QpOptions,
     weights: WeightSchedule,
     lower: JointVector,
@@ -346,21 +287,27 @@ struct Controller<'a> {
     /// Created at the first step where a constraint binds.
     clarabel: Option<Clarabel>,
     timing: Timing,
+    /// The component errors at the last step of the segment's own problem.
+    errors: [Real; 3],
+    /// The largest error of each component over the segment's own steps.
+    max_errors: [Real; 3],
+    /// Holding the state where the loop stopped (its errors are not the segment's).
+    holding: bool,
 }
 
 impl<'a> Controller<'a> {
     fn new(
         robot: &'a Robot,
         scene: &'a CollisionScene,
-        problem: &'a SegmentProblem,
+        problem: SegmentProblem,
         options: &'a QpOptions,
     ) -> Self {
         Self {
             robot,
             scene,
+            weights: WeightSchedule::new(problem.duration, options.weights),
             problem,
             options,
-            weights: WeightSchedule::new(problem.duration, options.weights),
             lower: robot.lower(),
             upper: robot.upper(),
             speed: robot.velocity_limits() * options.velocity_fraction,
@@ -368,15 +315,24 @@ impl<'a> Controller<'a> {
                 * (options.acceleration_scale * options.acceleration_fraction),
             clarabel: None,
             timing: Timing::default(),
+            errors: [Real::INFINITY; 3],
+            max_errors: [0.0; 3],
+            holding: false,
         }
     }
 
-    /// The velocity to ramp to over the step from `q`, where the arm moves at `current`.
-    fn step(&mut self, q: &JointVector, current: &JointVector, t: Real) -> Result<Step, QpError> {
+    /// The velocity to ramp to over the step from `q` (at `pose`), where the arm moves at
+    /// `current`.
+    fn step(
+        &mut self,
+        pose: &ArmPose,
+        q: &JointVector,
+        current: &JointVector,
+        t: Real,
+    ) -> Result<Step, QpError> {
         let started = Instant::now();
-        let pose = arm_pose(self.robot, q);
         let singular = |source| QpError::Singular { time: t, source };
-        let (jacobian, values) = self.measure(&pose).map_err(singular)?;
+        let (jacobian, values) = self.measure(pose).map_err(singular)?;
         let (target, weights, errors) = self.task(t, &values);
 
         // ½‖W(J x - V)‖² + ½λ‖x‖²: P = Jᵀ W² J + λ I, c = Jᵀ W² V.
@@ -385,7 +341,7 @@ impl<'a> Controller<'a> {
         let c = weighted.transpose() * target;
         let (lower, upper) = self.bounds(q);
         let (ramp_lower, ramp_upper) = self.ramp(&lower, &upper, current);
-        let rows = self.damper_rows(&pose);
+        let rows = self.damper_rows(pose);
 
         let cholesky = p.cholesky();
         let exact = |lower: &Vector7, upper: &Vector7| {
@@ -554,11 +510,10 @@ impl<'a> Controller<'a> {
         x
     }
 
-    /// A problem holding every variable at its value at `q` for `duration`.
-    fn hold_problem(&self, q: &JointVector, duration: Real) -> Result<SegmentProblem, QpError> {
-        let pose = arm_pose(self.robot, q);
+    /// A problem holding every variable at its value at `pose` for `duration`.
+    fn hold_problem(&self, pose: &ArmPose, duration: Real) -> Result<SegmentProblem, QpError> {
         let (_, values) =
-            self.measure(&pose).map_err(|source| QpError::Singular { time: 0.0, source })?;
+            self.measure(pose).map_err(|source| QpError::Singular { time: 0.0, source })?;
         let hold = |c: &Component, value: Target| -> Result<Component, QpError> {
             let reference = Reference::hold(c.variable, value, duration)
                 .map_err(|e| QpError::Hold { reason: e.to_string() })?;
@@ -572,24 +527,58 @@ impl<'a> Controller<'a> {
         })
     }
 
-    fn within(&self, errors: &[Real; 3]) -> bool {
-        let tol = &self.options.tolerance;
-        self.problem.components.iter().zip(errors).all(|(c, e)| *e <= tol.of(c.variable))
-    }
-
-    /// The errors in units of their tolerances, summed: one number that falls as the arm
-    /// approaches the goal.
-    fn score(&self, errors: &[Real; 3]) -> Real {
-        let tol = &self.options.tolerance;
-        self.problem.components.iter().zip(errors).map(|(c, e)| e / tol.of(c.variable)).sum()
-    }
 }
 
-/// Rows of a variable in its space's Jacobian: 3 for positions and rotations, 1 for angles.
-fn width(variable: Variable) -> usize {
-    match variable {
-        Variable::Swivel | Variable::Elbow => 1,
-        Variable::Pw | Variable::Ow | Variable::Os => 3,
+impl Resolver for Controller<'_> {
+    type Error = QpError;
+
+    /// The step's answer, its error the largest component error in tolerance units.
+    fn resolve(
+        &mut self,
+        pose: &ArmPose,
+        q: &JointVector,
+        velocity: &JointVector,
+        t: Real,
+    ) -> Result<Resolved, QpError> {
+        let step = self.step(pose, q, velocity, t)?;
+        if !self.holding {
+            for (m, e) in self.max_errors.iter_mut().zip(step.errors) {
+                *m = Real::max(*m, e);
+            }
+            self.errors = step.errors;
+        }
+        let units = judge::tolerance_units(
+            &self.options.tolerance,
+            &self.problem.components,
+            &step.errors,
+        );
+        Ok(Resolved { velocity: step.velocity, error: units.iter().copied().fold(0.0, Real::max) })
+    }
+
+    /// The component errors in tolerance units, summed: one number that falls as the arm
+    /// approaches the goal.
+    fn progress(&self, _: &Resolved) -> Real {
+        let units =
+            judge::tolerance_units(&self.options.tolerance, &self.problem.components, &self.errors);
+        units.iter().sum()
+    }
+
+    /// Holds every variable where the arm stopped until it is at rest: braking takes as long
+    /// as the acceleration limits ask, at most the settle time plus that.
+    fn hold(
+        &mut self,
+        pose: &ArmPose,
+        velocity: &JointVector,
+        step: Real,
+    ) -> Result<Option<usize>, QpError> {
+        let hold = self.hold_problem(pose, self.options.max_settle.max(step))?;
+        self.weights = WeightSchedule::new(hold.duration, self.options.weights);
+        self.problem = hold;
+        self.clarabel = None;
+        self.holding = true;
+        let settle_steps = (self.options.max_settle / step).ceil() as usize;
+        let braking = (velocity.component_div(&self.acceleration).amax() / step).ceil() as usize;
+        Ok(Some(settle_steps.max(1) + braking))
     }
 }
 
@@ -802,11 +791,6 @@ struct Timing {
 impl Timing {
     fn record(&mut self, seconds: Real, clarabel: bool) {
         if clarabel { self.clarabel.push(seconds) } else { self.fast.push(seconds) }
-    }
-
-    fn merge(&mut self, other: Timing) {
-        self.fast.extend(other.fast);
-        self.clarabel.extend(other.clarabel);
     }
 
     fn stats(&self) -> QpStats {

@@ -20,14 +20,14 @@ use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 
 use super::monitor::Monitor;
+pub use super::timing::{LIMIT_FRACTION, TimedPath, shortest_bell, time_parameterise};
+use super::tree::{Tree, TreeSpace, connect_trees};
 use crate::collision::{
     CollisionModel, CollisionScene, advancement_at_least, clearance, min_distance, motion_bound,
 };
 use crate::kinematics::arm_pose;
 use crate::math::{JointVector, Real};
-use crate::profile::BellProfile;
 use crate::robot::Robot;
-use crate::trajectory::{Limits, Trajectory, TrajectoryError, sample_times};
 
 /// Settings of [`rrt_connect`].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -176,9 +176,6 @@ pub fn rrt_connect(
     rrt_connect_monitored(robot, scene, start, goals, options, &mut Monitor::silent())
 }
 
-/// Samples between two progress reports and deadline checks.
-pub(crate) const REPORT_EVERY: usize = 64;
-
 /// [`rrt_connect`], reporting the fraction of the sample budget used to `monitor` and
 /// stopping at its deadline.
 ///
@@ -194,8 +191,7 @@ pub fn rrt_connect_monitored(
 ) -> Result<RrtPath, RrtError> {
     check_options(options)?;
     let mut monitor = monitor.within(options.max_time);
-    let started = Instant::now();
-    let mut space = Space::new(robot, scene, options);
+    let mut space = JointSpace::new(robot, scene, options);
     if let Some(reason) = space.invalid(start) {
         return Err(RrtError::InvalidStart { reason });
     }
@@ -204,70 +200,23 @@ pub fn rrt_connect_monitored(
     if valid_goals.is_empty() {
         return Err(RrtError::NoValidGoal { count: goals.len() });
     }
-    let mut from_start = Tree::new(*start, None);
-    let mut from_goal = Tree::new(valid_goals[0].1, Some(valid_goals[0].0));
-    for &(index, g) in &valid_goals[1..] {
-        from_goal.nodes.push(Node { q: g, parent: None, goal: Some(index) });
-    }
-    let mut rng = StdRng::seed_from_u64(options.seed);
-    let (lower, upper) = (robot.lower(), robot.upper());
-    let mut samples = 0;
-    let mut swapped = false;
     // An edge straight from the start to a goal needs no tree.
     for &(index, g) in &valid_goals {
         if space.edge_free(start, &g, false) {
-            let stats = space.stats(1, 0, started);
+            let stats = space.stats(1, 0);
             return Ok(RrtPath { waypoints: vec![*start, g], goal: index, stats });
         }
     }
-    while samples < options.max_samples {
-        if samples % REPORT_EVERY == 0 {
-            if monitor.expired() {
-                let nodes = from_start.nodes.len() + from_goal.nodes.len();
-                return Err(RrtError::Timeout { stats: space.stats(samples, nodes, started) });
-            }
-            monitor.report(samples as Real / options.max_samples as Real);
-        }
-        samples += 1;
-        let sample = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
-        let (grow, other) = if swapped {
-            (&mut from_goal, &mut from_start)
-        } else {
-            (&mut from_start, &mut from_goal)
-        };
-        if let Some(new) = grow.extend(&sample, &mut space) {
-            let q = grow.nodes[new].q;
-            if let Some(reached) = other.connect(&q, &mut space) {
-                let (a, b) = if swapped { (reached, new) } else { (new, reached) };
-                let (s_tree, g_tree) = if swapped { (&*other, &*grow) } else { (&*grow, &*other) };
-                let mut waypoints = s_tree.path_to_root(a);
-                waypoints.reverse();
-                let tail = g_tree.path_to_root(b);
-                let goal = g_tree.root_goal(b);
-                waypoints.extend(tail);
-                let waypoints = shortcut(waypoints, &mut space, &mut rng, options.shortcuts);
-                let nodes = from_start.nodes.len() + from_goal.nodes.len();
-                return Ok(RrtPath {
-                    waypoints,
-                    goal,
-                    stats: space.stats(samples, nodes, started),
-                });
-            }
-        }
-        swapped = !swapped;
-    }
-    let closest =
-        closest_pair(from_start.nodes.iter().map(|n| &n.q), from_goal.nodes.iter().map(|n| &n.q));
-    let nodes = from_start.nodes.len() + from_goal.nodes.len();
-    Err(RrtError::NoPath { closest, stats: space.stats(samples, nodes, started) })
-}
-
-/// The joint-space distance between the closest configurations of two trees (rad).
-pub(crate) fn closest_pair<'a>(
-    a: impl Iterator<Item = &'a JointVector>,
-    b: impl Iterator<Item = &'a JointVector> + Clone,
-) -> Real {
-    a.flat_map(|p| b.clone().map(move |q| (p - q).norm())).fold(Real::INFINITY, Real::min)
+    let from_start = Tree::of_roots([Node { q: *start, goal: None }]);
+    let from_goal =
+        Tree::of_roots(valid_goals.iter().map(|&(index, q)| Node { q, goal: Some(index) }));
+    let mut rng = StdRng::seed_from_u64(options.seed);
+    let connected =
+        connect_trees(&mut space, from_start, from_goal, &mut rng, options.max_samples, &mut monitor)?;
+    let goal = connected.path.last().and_then(|n| n.goal).unwrap_or(0);
+    let waypoints = connected.path.into_iter().map(|n| n.q).collect();
+    let waypoints = shortcut(waypoints, &mut space, &mut rng, options.shortcuts);
+    Ok(RrtPath { waypoints, goal, stats: space.stats(connected.samples, connected.nodes) })
 }
 
 pub(crate) fn check_options(o: &RrtOptions) -> Result<(), RrtError> {
@@ -286,7 +235,7 @@ pub(crate) fn check_options(o: &RrtOptions) -> Result<(), RrtError> {
 }
 
 /// The configuration space: limits, collision checks and their count.
-struct Space<'a> {
+struct JointSpace<'a> {
     robot: &'a Robot,
     scene: &'a CollisionScene,
     options: &'a RrtOptions,
@@ -294,6 +243,8 @@ struct Space<'a> {
     /// Uncovered stretches of the edge being checked (reused, to allocate once).
     gaps: Vec<Gap>,
     checks: usize,
+    /// When the search started, for its wall time.
+    started: Instant,
 }
 
 /// A stretch (from, to) of an edge's parameter not yet known to keep the clearance, and whether
@@ -307,10 +258,11 @@ struct Gap {
     tight_b: bool,
 }
 
-impl<'a> Space<'a> {
+impl<'a> JointSpace<'a> {
     fn new(robot: &'a Robot, scene: &'a CollisionScene, options: &'a RrtOptions) -> Self {
         let model = CollisionModel::new(robot, scene);
-        Self { robot, scene, options, model, gaps: Vec::new(), checks: 0 }
+        let started = Instant::now();
+        Self { robot, scene, options, model, gaps: Vec::new(), checks: 0, started }
     }
 
     /// Why `q` is not a valid end (within the limits, `clearance` from the scene), if it is not.
@@ -390,116 +342,57 @@ impl<'a> Space<'a> {
         true
     }
 
-    fn stats(&self, samples: usize, nodes: usize, started: Instant) -> RrtStats {
-        RrtStats::since(started, samples, nodes, self.checks)
-    }
 }
 
+/// A node of a joint-space tree: its configuration, and for a goal tree's root which goal it
+/// is.
+#[derive(Debug, Clone, Copy)]
 struct Node {
     q: JointVector,
-    parent: Option<usize>,
-    /// For a goal tree's root: which goal it is.
     goal: Option<usize>,
 }
 
-struct Tree {
-    nodes: Vec<Node>,
-}
+impl TreeSpace for JointSpace<'_> {
+    type Node = Node;
+    type Target = JointVector;
 
-/// The outcome of one step of a tree towards a target.
-pub(crate) enum Extension {
-    /// The target was reached: the new node.
-    Reached(usize),
-    /// A step towards it was taken: the new node.
-    Advanced(usize),
-    /// The step was blocked.
-    Trapped,
-}
-
-impl Extension {
-    /// The new node, if any.
-    pub(crate) fn node(self) -> Option<usize> {
-        match self {
-            Extension::Reached(i) | Extension::Advanced(i) => Some(i),
-            Extension::Trapped => None,
-        }
-    }
-}
-
-/// The index of the configuration nearest to `q` (Euclidean in joint space); 0 for none.
-pub(crate) fn nearest<'a>(
-    configurations: impl Iterator<Item = &'a JointVector>,
-    q: &JointVector,
-) -> usize {
-    let mut best = (0, Real::INFINITY);
-    for (i, c) in configurations.enumerate() {
-        let d = (c - q).norm_squared();
-        if d < best.1 {
-            best = (i, d);
-        }
-    }
-    best.0
-}
-
-impl Tree {
-    fn new(root: JointVector, goal: Option<usize>) -> Self {
-        Self { nodes: vec![Node { q: root, parent: None, goal }] }
+    fn sample(&mut self, rng: &mut StdRng) -> Option<JointVector> {
+        let (lower, upper) = (self.robot.lower(), self.robot.upper());
+        Some(JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i])))
     }
 
-    fn nearest(&self, q: &JointVector) -> usize {
-        nearest(self.nodes.iter().map(|n| &n.q), q)
+    fn target(&self, node: &Node) -> JointVector {
+        node.q
     }
 
-    /// One step from the nearest node towards `target`, a new configuration or a node of the
-    /// other tree.
-    fn step(&mut self, target: &JointVector, new_target: bool, space: &mut Space) -> Extension {
-        let near = self.nearest(target);
-        let from = self.nodes[near].q;
-        let delta = target - from;
+    fn joints(node: &Node) -> &JointVector {
+        &node.q
+    }
+
+    fn target_joints(target: &JointVector) -> &JointVector {
+        target
+    }
+
+    /// Straight in joint space by at most [`RrtOptions::step`].
+    fn steer(
+        &mut self,
+        from: &Node,
+        target: &JointVector,
+        new_target: bool,
+    ) -> Option<(Node, bool)> {
+        let delta = target - from.q;
         let distance = delta.norm();
-        let (to, reached) = if distance <= space.options.step {
+        let (to, reached) = if distance <= self.options.step {
             (*target, true)
         } else {
-            (from + delta * (space.options.step / distance), false)
+            (from.q + delta * (self.options.step / distance), false)
         };
-        if !space.edge_free(&from, &to, new_target || !reached) {
-            return Extension::Trapped;
-        }
-        self.nodes.push(Node { q: to, parent: Some(near), goal: None });
-        let new = self.nodes.len() - 1;
-        if reached { Extension::Reached(new) } else { Extension::Advanced(new) }
+        self.edge_free(&from.q, &to, new_target || !reached)
+            .then_some((Node { q: to, goal: None }, reached))
     }
 
-    fn extend(&mut self, target: &JointVector, space: &mut Space) -> Option<usize> {
-        self.step(target, true, space).node()
-    }
-
-    /// Steps towards `target` until it is reached (its node) or blocked.
-    fn connect(&mut self, target: &JointVector, space: &mut Space) -> Option<usize> {
-        loop {
-            match self.step(target, false, space) {
-                Extension::Reached(i) => return Some(i),
-                Extension::Advanced(_) => continue,
-                Extension::Trapped => return None,
-            }
-        }
-    }
-
-    /// Configurations from node `i` up to the root.
-    fn path_to_root(&self, mut i: usize) -> Vec<JointVector> {
-        let mut out = vec![self.nodes[i].q];
-        while let Some(p) = self.nodes[i].parent {
-            out.push(self.nodes[p].q);
-            i = p;
-        }
-        out
-    }
-
-    fn root_goal(&self, mut i: usize) -> usize {
-        while let Some(p) = self.nodes[i].parent {
-            i = p;
-        }
-        self.nodes[i].goal.unwrap_or(0)
+    fn stats(&self, samples: usize, nodes: usize) -> RrtStats {
+        RrtStats::since(self.started, samples, nodes, self.checks)
     }
 }
 
@@ -508,7 +401,7 @@ impl Tree {
 /// ends once every pair is.
 fn shortcut(
     mut path: Vec<JointVector>,
-    space: &mut Space,
+    space: &mut JointSpace,
     rng: &mut StdRng,
     attempts: usize,
 ) -> Vec<JointVector> {
@@ -533,100 +426,8 @@ fn shortcut(
     path
 }
 
-/// A path timed with bell-shaped speeds (paper eq. 9).
-#[derive(Debug, Clone, PartialEq)]
-pub struct TimedPath {
-    /// Samples at the rate asked for, plus the end.
-    pub trajectory: Trajectory,
-    /// The duration used (s).
-    pub duration: Real,
-    /// Whether the duration asked for was stretched to keep every joint within its speed and
-    /// acceleration limits.
-    pub stretched: bool,
-}
-
-/// The share of a limit that planned timing uses; the rest absorbs the interpolation of the
-/// output between samples.
-pub const LIMIT_FRACTION: Real = 0.95;
-
-/// The shortest rest-to-rest bell over `length` along the unit joint direction `u` that keeps
-/// every joint within [`LIMIT_FRACTION`] of its limits: the bell's peak speed is 2L/T and its
-/// peak acceleration 2πL/T², joint i moving |u_i| times as much.
-pub fn shortest_bell(u: &JointVector, length: Real, limits: &Limits) -> Real {
-    (0..u.len())
-        .map(|i| {
-            let d = length * u[i].abs();
-            let v = LIMIT_FRACTION * limits.velocity[i];
-            let a = LIMIT_FRACTION * limits.acceleration[i];
-            (2.0 * d / v).max((2.0 * crate::math::PI * d / a).sqrt())
-        })
-        .fold(0.0, Real::max)
-}
-
-/// Times `waypoints` as one rest-to-rest bell (paper eq. 9) per straight edge: the speed and
-/// acceleration vanish at every waypoint, so the motion is C² with no velocity step, and it
-/// stays on the edges the collision checks covered. The path takes `duration`, or the sum of
-/// the edges' shortest bells within the limits ([`shortest_bell`]) when that is longer.
-///
-/// # Errors
-/// [`TrajectoryError`] for no waypoint, a non-positive rate or duration, or non-finite values.
-pub fn time_parameterise(
-    limits: &Limits,
-    waypoints: &[JointVector],
-    duration: Real,
-    rate: Real,
-) -> Result<TimedPath, TrajectoryError> {
-    let first = *waypoints.first().ok_or(TrajectoryError::Empty)?;
-    if !(rate.is_finite() && rate > 0.0) {
-        return Err(TrajectoryError::InvalidRate { rate_hz: rate });
-    }
-    let edges: Vec<(JointVector, JointVector, Real)> = waypoints
-        .windows(2)
-        .filter(|w| (w[1] - w[0]).norm() > 0.0)
-        .map(|w| (w[0], (w[1] - w[0]).normalize(), (w[1] - w[0]).norm()))
-        .collect();
-    // Each edge's share of the duration is in proportion to its shortest bell, so that every
-    // edge uses the same share of its limits, and none is stretched unless all are.
-    let shortest: Vec<Real> = edges.iter().map(|(_, u, l)| shortest_bell(u, *l, limits)).collect();
-    let least: Real = shortest.iter().sum();
-    let scale = if least > 0.0 { (duration / least).max(1.0) } else { 1.0 };
-    let bells = edges
-        .iter()
-        .zip(&shortest)
-        .map(|((_, _, l), short)| BellProfile::new(short * scale, *l))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(TrajectoryError::Join)?;
-    let total: Real = bells.iter().map(BellProfile::duration).sum();
-    if edges.is_empty() {
-        let trajectory = Trajectory::new(vec![0.0], vec![first], vec![JointVector::zeros()])?;
-        return Ok(TimedPath { trajectory, duration: 0.0, stretched: false });
-    }
-    // The rate's grid plus every waypoint's time, where the motion rests.
-    let mut times = sample_times(0.0, total, rate);
-    let mut start = 0.0;
-    for bell in &bells {
-        start += bell.duration();
-        times.push(start);
-    }
-    times.sort_by(Real::total_cmp);
-    times.dedup_by(|b, a| *b - *a <= 1e-9 / rate);
-    let mut samples = Vec::with_capacity(times.len());
-    let (mut edge, mut edge_start) = (0, 0.0);
-    for &t in &times {
-        while edge + 1 < edges.len() && t > edge_start + bells[edge].duration() {
-            edge_start += bells[edge].duration();
-            edge += 1;
-        }
-        let (from, u, _) = &edges[edge];
-        let local = t - edge_start;
-        samples.push((from + u * bells[edge].progress(local), u * bells[edge].speed(local)));
-    }
-    let (positions, velocities) = samples.into_iter().unzip();
-    let trajectory = Trajectory::new(times, positions, velocities)?;
-    Ok(TimedPath { trajectory, duration: total, stretched: total > duration * (1.0 + 1e-9) })
-}
-
 /// The length of a joint-space path (rad, Euclidean per edge).
 pub fn path_length(waypoints: &[JointVector]) -> Real {
     waypoints.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
 }
+

@@ -23,7 +23,7 @@ use crate::language::{Space, Variable};
 use crate::math::{JointVector, Real, Rotation3, Vector3};
 use crate::profile::Role;
 use crate::profile::{Reference, Sample};
-use crate::solve::qp::SegmentProblem;
+use crate::solve::problem::SegmentProblem;
 
 /// Settings of the map and its profile.
 #[derive(Debug, Clone, PartialEq)]

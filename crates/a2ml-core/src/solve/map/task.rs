@@ -10,7 +10,7 @@ use crate::math::JointVector;
 use crate::robot::Robot;
 use crate::solve::SolveError;
 use crate::solve::plan::segment_problem;
-use crate::solve::qp::SegmentProblem;
+use crate::solve::problem::SegmentProblem;
 
 /// A segment's map with what it was built from, and its profile or why there is none.
 #[derive(Debug, Clone)]
