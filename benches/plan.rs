@@ -49,6 +49,7 @@ fn qp(c: &mut Criterion) {
         shape: Shape::Box {
             center: p0 + Vector3::new(0.0, -0.08, -0.09),
             size: Vector3::new(0.3, 0.1, 0.05),
+            rotation: Rotation3::identity(),
         },
     };
     let options = QpOptions::default();

@@ -4,7 +4,7 @@ use crate::common::{all_robots, load, random_q, rng};
 use a2ml::collision::*;
 use a2ml::kinematics::arm_pose;
 use a2ml::language::{Obstacle, Shape};
-use a2ml::math::{Real, Vector3};
+use a2ml::math::{Real, Rotation3, UnitQuaternion, Vector3};
 use a2ml::robot::LinkRole;
 use rand::RngExt;
 use rand::rngs::StdRng;
@@ -86,6 +86,20 @@ fn capsule_sphere_matches_brute_force() {
     assert!(penetrating > 20, "too few penetrations exercised: {penetrating}");
 }
 
+/// Axis-aligned half of the time, else a uniform random rotation.
+fn random_rotation(rng: &mut StdRng) -> Rotation3 {
+    if rng.random_range(0.0..1.0) < 0.5 {
+        return Rotation3::identity();
+    }
+    let q = nalgebra::Quaternion::new(
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+    );
+    UnitQuaternion::from_quaternion(q).to_rotation_matrix()
+}
+
 fn random_scene(rng: &mut StdRng) -> Vec<Obstacle> {
     (0..6)
         .map(|i| {
@@ -99,6 +113,7 @@ fn random_scene(rng: &mut StdRng) -> Vec<Obstacle> {
                         rng.random_range(0.02..0.4),
                         rng.random_range(0.02..0.4),
                     ),
+                    rotation: random_rotation(rng),
                 },
                 2 => Shape::Capsule {
                     a: center,
@@ -109,6 +124,7 @@ fn random_scene(rng: &mut StdRng) -> Vec<Obstacle> {
                     center,
                     radius: rng.random_range(0.02..0.2),
                     height: rng.random_range(0.02..0.5),
+                    rotation: random_rotation(rng),
                 },
             };
             Obstacle { name: format!("o{i}"), shape }

@@ -96,6 +96,8 @@ mod malformed {
     malformed!(ow_only_segment, 4, 5, "a segment covers a whole space");
     malformed!(duplicate_obstacle, 4, 3, "obstacle `post` is declared twice");
     malformed!(negative_radius, 3, 37, "the radius must be positive");
+    malformed!(shape_rotation_not_a_rotation, 3, 61, "the shape's orientation is a rotation");
+    malformed!(shape_zero_axis, 3, 62, "the axis must not be zero");
     malformed!(start_wrong_count, 2, 7, "the start configuration needs 7 numbers, but 3 are given");
     malformed!(start_state_incomplete, 2, 7, "also needs Ow");
     malformed!(missing_robot_file, 1, 8, "robot file not found");

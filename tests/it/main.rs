@@ -22,6 +22,7 @@ mod push_box;
 mod repository;
 mod robots;
 mod rrt;
+mod scene;
 mod segments;
 mod smoothness;
 mod swivel;

@@ -244,6 +244,7 @@ fn obstacles_are_kept_at_the_safety_distance_when_the_path_grazes_them() {
         shape: Shape::Box {
             center: p0 + Vector3::new(0.0, -0.08, -0.09),
             size: Vector3::new(0.3, 0.1, 0.05),
+            rotation: Rotation3::identity(),
         },
     };
     let scene = CollisionScene::new(&[below]);

@@ -108,6 +108,8 @@ def test_scene_in_metres(task: Task) -> None:
     assert bar["shape"] == "capsule" and bar["radius"] == pytest.approx(0.02)
     np.testing.assert_allclose(bar["a"], [0.3, -0.3, 0.1])
     np.testing.assert_allclose(bar["b"], [0.3, 0.3, 0.1])
+    np.testing.assert_array_equal(table["rotation"], np.eye(3))
+    rotation = post.pop("rotation")
     assert post == {
         "name": "post",
         "shape": "cylinder",
@@ -115,7 +117,25 @@ def test_scene_in_metres(task: Task) -> None:
         "radius": 0.03,
         "height": 1.0,
     }
+    np.testing.assert_array_equal(rotation, np.eye(3))
     assert ball["shape"] == "sphere" and ball["radius"] == pytest.approx(0.05)
+
+
+def test_rotated_shapes() -> None:
+    text = (
+        f'robot "{ROBOT_FROM_TESTS}"\n'
+        "scene {\n"
+        "  shelf = box at [0.4, 0, 0] size [0.2, 0.1, 0.02] rotation rpy(0, 0, 90) deg\n"
+        "  post = cylinder at [0.3, 0, 0] radius 0.03 height 0.5 axis [0, 1, 0]\n"
+        "  rail = capsule at [0.3, 0, 0.1] radius 0.02 height 0.4 axis [1, 0, 0]\n"
+        "}\n"
+        "task t { action a { goal θe = 1 } }\n"
+    )
+    shelf, post, rail = a2ml.parse(text, str(TESTS_DIR / "rotated.a2ml")).scene
+    np.testing.assert_allclose(shelf["rotation"] @ [1, 0, 0], [0, 1, 0], atol=1e-12)
+    np.testing.assert_allclose(post["rotation"] @ [0, 0, 1], [0, 1, 0], atol=1e-12)
+    np.testing.assert_allclose(rail["a"], [0.1, 0, 0.1], atol=1e-12)
+    np.testing.assert_allclose(rail["b"], [0.5, 0, 0.1], atol=1e-12)
 
 
 def test_constraint_action_with_priorities(task: Task) -> None:

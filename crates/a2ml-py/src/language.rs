@@ -245,10 +245,11 @@ fn obstacle<'py>(py: Python<'py>, o: &Obstacle) -> PyResult<Dict<'py>> {
     let d = PyDict::new(py);
     d.set_item("name", &o.name)?;
     match &o.shape {
-        Shape::Box { center, size } => {
+        Shape::Box { center, size, rotation } => {
             d.set_item("shape", "box")?;
             d.set_item("center", to_vector(py, center.as_slice()))?;
             d.set_item("size", to_vector(py, size.as_slice()))?;
+            d.set_item("rotation", to_rotation(py, rotation))?;
         }
         Shape::Sphere { center, radius } => {
             d.set_item("shape", "sphere")?;
@@ -261,11 +262,12 @@ fn obstacle<'py>(py: Python<'py>, o: &Obstacle) -> PyResult<Dict<'py>> {
             d.set_item("b", to_vector(py, b.as_slice()))?;
             d.set_item("radius", radius)?;
         }
-        Shape::Cylinder { center, radius, height } => {
+        Shape::Cylinder { center, radius, height, rotation } => {
             d.set_item("shape", "cylinder")?;
             d.set_item("center", to_vector(py, center.as_slice()))?;
             d.set_item("radius", radius)?;
             d.set_item("height", height)?;
+            d.set_item("rotation", to_rotation(py, rotation))?;
         }
     }
     Ok(d)

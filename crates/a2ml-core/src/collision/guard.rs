@@ -4,7 +4,7 @@
 //! panics, on sizes near the largest number).
 
 use crate::language::{MAX_LENGTH, Obstacle, Shape};
-use crate::math::{Real, Vector3};
+use crate::math::{Matrix3, Real, Rotation3, Vector3};
 use crate::robot::Robot;
 
 /// A shape no collision query can check.
@@ -26,7 +26,7 @@ pub enum ShapeError {
     /// workspace bound.
     #[error(
         "obstacle `{name}` cannot be checked for collisions: {why} (sizes positive, \
-         everything finite and within {MAX_LENGTH} m)"
+         rotations orthonormal, everything finite and within {MAX_LENGTH} m)"
     )]
     Obstacle {
         /// The obstacle's name.
@@ -38,6 +38,15 @@ pub enum ShapeError {
 
 fn within(v: &Vector3) -> bool {
     v.iter().all(|x| x.is_finite() && x.abs() <= MAX_LENGTH)
+}
+
+/// A rotation matrix within rounding: orthonormal, determinant one (a `Rotation3` built
+/// unchecked can be anything).
+fn proper(r: &Rotation3) -> bool {
+    let m = r.matrix();
+    m.iter().all(|x| x.is_finite())
+        && (m.transpose() * m - Matrix3::identity()).amax() < 1e-6
+        && m.determinant() > 0.0
 }
 
 fn size_ok(x: Real, positive: bool) -> bool {
@@ -63,11 +72,13 @@ pub fn check_shapes(robot: &Robot, obstacles: &[Obstacle]) -> Result<(), ShapeEr
     }
     for o in obstacles {
         let ok = match &o.shape {
-            Shape::Box { center, size } => within(center) && size.iter().all(|s| size_ok(*s, true)),
+            Shape::Box { center, size, rotation } => {
+                within(center) && size.iter().all(|s| size_ok(*s, true)) && proper(rotation)
+            }
             Shape::Sphere { center, radius } => within(center) && size_ok(*radius, true),
             Shape::Capsule { a, b, radius } => within(a) && within(b) && size_ok(*radius, true),
-            Shape::Cylinder { center, radius, height } => {
-                within(center) && size_ok(*radius, true) && size_ok(*height, true)
+            Shape::Cylinder { center, radius, height, rotation } => {
+                within(center) && size_ok(*radius, true) && size_ok(*height, true) && proper(rotation)
             }
         };
         if !ok {

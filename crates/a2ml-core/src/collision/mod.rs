@@ -9,13 +9,15 @@
 //! units. parry enters the crate here only; its glam types never leave this
 //! module.
 
-use parry3d_f64::math::{Pose, Vector};
+use std::f64::consts::FRAC_PI_2;
+
+use parry3d_f64::math::{Pose, Rotation, Vector};
 use parry3d_f64::query::{self, Contact};
 use parry3d_f64::shape::{Ball, Cuboid, Cylinder, Segment, Shape as ParryShape};
 
 use crate::kinematics::ArmPose;
 use crate::language::{Obstacle, Shape};
-use crate::math::{Real, Vector3};
+use crate::math::{Real, Rotation3, UnitQuaternion, Vector3};
 use crate::robot::{LinkRole, Robot};
 
 mod guard;
@@ -231,6 +233,12 @@ fn to_parry(v: &Vector3) -> Vector {
     Vector::new(v.x, v.y, v.z)
 }
 
+/// The parry pose placing a shape's centre at `center`, turned by `rotation`.
+fn pose(center: &Vector3, rotation: &Rotation3) -> Pose {
+    let q = UnitQuaternion::from_rotation_matrix(rotation).into_inner().coords;
+    Pose::from_parts(to_parry(center), Rotation::from_xyzw(q.x, q.y, q.z, q.w).normalize())
+}
+
 fn from_parry(v: Vector) -> Vector3 {
     Vector3::new(v.x, v.y, v.z)
 }
@@ -239,10 +247,10 @@ impl Body {
     fn from_obstacle(o: &Obstacle) -> Self {
         let name = o.name.clone();
         match &o.shape {
-            Shape::Box { center, size } => Self {
+            Shape::Box { center, size, rotation } => Self {
                 name,
                 shape: Core::Cuboid(Cuboid::new(to_parry(&(size * 0.5)))),
-                pose: Pose::from_translation(to_parry(center)),
+                pose: pose(center, rotation),
                 margin: 0.0,
                 center: *center,
                 bound: 0.5 * size.norm(),
@@ -258,13 +266,13 @@ impl Body {
                 frame: None,
             },
             Shape::Capsule { a, b, radius } => Self::capsule(name, a, b, *radius, None),
-            Shape::Cylinder { center, radius, height } => Self {
+            Shape::Cylinder { center, radius, height, rotation } => Self {
                 name,
                 shape: Core::Cylinder(Cylinder::new(0.5 * height, *radius)),
-                // parry's cylinder runs along y; turn y onto z.
-                pose: Pose::new(
-                    to_parry(center),
-                    Vector::new(std::f64::consts::FRAC_PI_2, 0.0, 0.0),
+                // parry's cylinder runs along y; turn y onto z first.
+                pose: pose(
+                    center,
+                    &(rotation * Rotation3::from_axis_angle(&Vector3::x_axis(), FRAC_PI_2)),
                 ),
                 margin: 0.0,
                 center: *center,

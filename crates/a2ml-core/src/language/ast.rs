@@ -197,12 +197,14 @@ pub struct Obstacle {
 /// An obstacle's shape as written.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub enum Shape {
-    /// `box at [..] size [..]`: centre and full edge lengths.
+    /// `box at [..] size [..]`: centre and full edge lengths, optionally rotated.
     Box {
         /// Centre.
         at: Vector,
         /// Edge lengths.
         size: Vector,
+        /// `rotation ..` or `axis [..]`; axis-aligned without.
+        orientation: Option<Orientation>,
     },
     /// `sphere at [..] radius r`.
     Sphere {
@@ -220,7 +222,20 @@ pub enum Shape {
         /// Radius.
         radius: Quantity,
     },
-    /// `cylinder at [..] radius r height h`: vertical, centred at `at`.
+    /// `capsule at [..] radius r height h`: the segment of length h centred at `at` along the
+    /// local z, vertical without an orientation.
+    CapsuleAt {
+        /// Centre.
+        at: Vector,
+        /// Radius.
+        radius: Quantity,
+        /// Length of the segment, the caps excluded.
+        height: Quantity,
+        /// `rotation ..` or `axis [..]`.
+        orientation: Option<Orientation>,
+    },
+    /// `cylinder at [..] radius r height h`: centred at `at` along the local z, vertical
+    /// without an orientation.
     Cylinder {
         /// Centre.
         at: Vector,
@@ -228,9 +243,20 @@ pub enum Shape {
         radius: Quantity,
         /// Height.
         height: Quantity,
+        /// `rotation ..` or `axis [..]`.
+        orientation: Option<Orientation>,
     },
     /// A shape keyword the grammar does not know.
     Unknown(Name),
+}
+
+/// How a shape is turned about its centre.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub enum Orientation {
+    /// `rotation rpy(..)`, `quat(..)` or `axes(x: .., z: ..)`: the shape's frame in the scene's.
+    Rotation(Value),
+    /// `axis [..]`: where the shape's local z points (the shortest turn from z).
+    Axis(Vector),
 }
 
 /// `settings { name value ... }`.

@@ -13,7 +13,7 @@ use std::collections::BTreeMap;
 
 use super::ast::{
     Action, ActionBody, Combine, Comment, Facts, Feature, File, Goal, GoalTerm, Item, Name,
-    Obstacle, Path, Primitive, PrimitiveConstraint, Quantity, Scene, Segment, Setting,
+    Obstacle, Orientation, Path, Primitive, PrimitiveConstraint, Quantity, Scene, Segment, Setting,
     SettingValue, Settings, Shape, Span, Start, Task, Value, Vector,
 };
 use crate::math::Real;
@@ -503,9 +503,18 @@ fn shape_keyword(shape: &Shape) -> &str {
     match shape {
         Shape::Box { .. } => "box",
         Shape::Sphere { .. } => "sphere",
-        Shape::Capsule { .. } => "capsule",
+        Shape::Capsule { .. } | Shape::CapsuleAt { .. } => "capsule",
         Shape::Cylinder { .. } => "cylinder",
         Shape::Unknown(name) => &name.text,
+    }
+}
+
+/// ` rotation ..` or ` axis [..]` after an argument whose unit is `before`; nothing without.
+fn orientation(o: Option<&Orientation>, before: Option<&Name>) -> String {
+    match o {
+        None => String::new(),
+        Some(Orientation::Rotation(v)) => format!("{}rotation {}", gap(before), value(v)),
+        Some(Orientation::Axis(v)) => format!("{}axis {}", gap(before), vector(v)),
     }
 }
 
@@ -513,9 +522,13 @@ fn shape_keyword(shape: &Shape) -> &str {
 /// scene's columns.
 fn obstacle(o: &Obstacle, name_width: usize, shape_width: usize) -> String {
     let args = match &o.shape {
-        Shape::Box { at, size } => {
-            format!("at {}{}size {}", vector(at), gap(at.unit.as_ref()), vector(size))
-        }
+        Shape::Box { at, size, orientation: o } => format!(
+            "at {}{}size {}{}",
+            vector(at),
+            gap(at.unit.as_ref()),
+            vector(size),
+            orientation(o.as_ref(), size.unit.as_ref())
+        ),
         Shape::Sphere { at, radius } => {
             format!("at {}{}radius {}", vector(at), gap(at.unit.as_ref()), quantity(radius))
         }
@@ -527,13 +540,15 @@ fn obstacle(o: &Obstacle, name_width: usize, shape_width: usize) -> String {
             gap(to.unit.as_ref()),
             quantity(radius)
         ),
-        Shape::Cylinder { at, radius, height } => format!(
-            "at {}{}radius {}{}height {}",
+        Shape::CapsuleAt { at, radius, height, orientation: o }
+        | Shape::Cylinder { at, radius, height, orientation: o } => format!(
+            "at {}{}radius {}{}height {}{}",
             vector(at),
             gap(at.unit.as_ref()),
             quantity(radius),
             gap(radius.unit.as_ref()),
-            quantity(height)
+            quantity(height),
+            orientation(o.as_ref(), height.unit.as_ref())
         ),
         Shape::Unknown(_) => String::new(),
     };

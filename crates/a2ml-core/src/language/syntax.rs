@@ -354,15 +354,33 @@ fn obstacle(node: Node<'_>) -> ast::Obstacle {
     let rule = shape_node.as_rule();
     let parts: Vec<Node<'_>> = shape_node.into_inner().collect();
     let mut vectors = parts.iter().filter(|p| p.as_rule() == Rule::vector).cloned().map(vector);
+    // `capsule from [..] to [..]` rather than `capsule at [..]`.
+    let ends = parts.iter().filter(|p| p.as_rule() == Rule::vector).count() == 2;
     let mut quantities =
         parts.iter().filter(|p| p.as_rule() == Rule::quantity).cloned().map(quantity);
     let mut v = || vectors.next().expect("grammar gives the shape's vectors");
     let mut q = || quantities.next().expect("grammar gives the shape's quantities");
+    let orientation = parts.iter().find(|p| p.as_rule() == Rule::orientation).map(|node| {
+        let node = first_inner(node.clone());
+        let rule = node.as_rule();
+        let inner = first_inner(node);
+        match rule {
+            Rule::shape_rotation => ast::Orientation::Rotation(value(inner)),
+            _ => ast::Orientation::Axis(vector(inner)),
+        }
+    });
     let shape = match rule {
-        Rule::box_shape => ast::Shape::Box { at: v(), size: v() },
+        Rule::box_shape => ast::Shape::Box { at: v(), size: v(), orientation },
         Rule::sphere_shape => ast::Shape::Sphere { at: v(), radius: q() },
-        Rule::capsule_shape => ast::Shape::Capsule { from: v(), to: v(), radius: q() },
-        Rule::cylinder_shape => ast::Shape::Cylinder { at: v(), radius: q(), height: q() },
+        Rule::capsule_shape if ends => {
+            ast::Shape::Capsule { from: v(), to: v(), radius: q() }
+        }
+        Rule::capsule_shape => {
+            ast::Shape::CapsuleAt { at: v(), radius: q(), height: q(), orientation }
+        }
+        Rule::cylinder_shape => {
+            ast::Shape::Cylinder { at: v(), radius: q(), height: q(), orientation }
+        }
         _ => ast::Shape::Unknown(name(parts[0].clone())),
     };
     ast::Obstacle { name: obstacle_name, shape, span: sp }

@@ -334,12 +334,14 @@ pub enum Start {
 /// An obstacle's shape, in {b} (or the root frame, per settings), SI.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub enum Shape {
-    /// Axis-aligned box: centre and full edge lengths.
+    /// Box: centre, full edge lengths along its own axes, and its rotation.
     Box {
         /// Centre.
         center: Vector3,
         /// Edge lengths.
         size: Vector3,
+        /// The box's axes in the scene frame (the identity for an axis-aligned box).
+        rotation: Rotation3,
     },
     /// Sphere.
     Sphere {
@@ -357,7 +359,7 @@ pub enum Shape {
         /// Radius.
         radius: Real,
     },
-    /// Vertical cylinder.
+    /// Cylinder along the z axis of its rotation.
     Cylinder {
         /// Centre.
         center: Vector3,
@@ -365,6 +367,9 @@ pub enum Shape {
         radius: Real,
         /// Height.
         height: Real,
+        /// The cylinder's axes in the scene frame: its own z is its axis (the identity for a
+        /// vertical one).
+        rotation: Rotation3,
     },
 }
 

@@ -966,14 +966,16 @@ impl Checker<'_> {
                 continue;
             }
             let shape = match &o.shape {
-                ast::Shape::Box { at, size } => (|| {
-                    let center = self.vector3(at, Dimension::Length, "the centre")?;
-                    let size = self.vector3(size, Dimension::Length, "the size")?;
+                ast::Shape::Box { at, size, orientation } => (|| {
+                    let center = self.vector3(at, Dimension::Length, "the centre");
+                    let size = self.vector3(size, Dimension::Length, "the size");
+                    let rotation = self.orientation(orientation.as_ref());
+                    let (center, size, rotation) = (center?, size?, rotation?);
                     if size.iter().any(|s| *s <= 0.0) {
                         self.error(o.span, "a box's size must be positive in x, y and z");
                         return None;
                     }
-                    Some(Shape::Box { center, size })
+                    Some(Shape::Box { center, size, rotation })
                 })(),
                 ast::Shape::Sphere { at, radius } => (|| {
                     Some(Shape::Sphere {
@@ -988,11 +990,25 @@ impl Checker<'_> {
                         radius: self.positive(radius, Dimension::Length, "the radius")?,
                     })
                 })(),
-                ast::Shape::Cylinder { at, radius, height } => (|| {
+                ast::Shape::CapsuleAt { at, radius, height, orientation } => (|| {
+                    let center = self.vector3(at, Dimension::Length, "the centre");
+                    let radius = self.positive(radius, Dimension::Length, "the radius");
+                    let height = self.positive(height, Dimension::Length, "the height");
+                    let rotation = self.orientation(orientation.as_ref());
+                    let half = rotation? * Vector3::z() * (0.5 * height?);
+                    let center = center?;
+                    Some(Shape::Capsule { a: center - half, b: center + half, radius: radius? })
+                })(),
+                ast::Shape::Cylinder { at, radius, height, orientation } => (|| {
+                    let center = self.vector3(at, Dimension::Length, "the centre");
+                    let radius = self.positive(radius, Dimension::Length, "the radius");
+                    let height = self.positive(height, Dimension::Length, "the height");
+                    let rotation = self.orientation(orientation.as_ref());
                     Some(Shape::Cylinder {
-                        center: self.vector3(at, Dimension::Length, "the centre")?,
-                        radius: self.positive(radius, Dimension::Length, "the radius")?,
-                        height: self.positive(height, Dimension::Length, "the height")?,
+                        center: center?,
+                        radius: radius?,
+                        height: height?,
+                        rotation: rotation?,
                     })
                 })(),
                 ast::Shape::Unknown(name) => {
@@ -1011,6 +1027,23 @@ impl Checker<'_> {
             }
         }
         out
+    }
+
+    /// A shape's rotation: the identity without an orientation; for an `axis`, the shortest
+    /// turn taking z onto it (half a turn about x for -z).
+    fn orientation(&mut self, orientation: Option<&ast::Orientation>) -> Option<Rotation3> {
+        match orientation {
+            None => Some(Rotation3::identity()),
+            Some(ast::Orientation::Rotation(value)) => {
+                self.rotation(value, ["x", "y"], "the shape's orientation")
+            }
+            Some(ast::Orientation::Axis(vector)) => {
+                let axis = self.direction(vector, "the axis")?;
+                Some(Rotation3::rotation_between(&Vector3::z(), &axis).unwrap_or_else(|| {
+                    Rotation3::from_axis_angle(&Vector3::x_axis(), PI)
+                }))
+            }
+        }
     }
 
     fn settings(&mut self, settings: &ast::Settings) -> Settings {

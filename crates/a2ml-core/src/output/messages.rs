@@ -308,15 +308,16 @@ fn obstacle_entity(time: Time, obstacle: &Obstacle) -> SceneEntity {
     let mut entity = SceneEntity::new(time, format!("obstacle/{}", obstacle.name), metadata);
     let color = OBSTACLE_COLOR;
     match &obstacle.shape {
-        Shape::Box { center, size } => {
-            entity.cubes.push(Solid { pose: Pose::at(center), size: size.into(), color });
+        Shape::Box { center, size, rotation } => {
+            let pose = Pose::new(center, &UnitQuaternion::from_rotation_matrix(rotation));
+            entity.cubes.push(Solid { pose, size: size.into(), color });
         }
         Shape::Sphere { center, radius } => entity.spheres.push(ball(center, *radius, color)),
         Shape::Capsule { a, b, radius } => add_capsule(&mut entity, a, b, *radius, color),
-        Shape::Cylinder { center, radius, height } => {
+        Shape::Cylinder { center, radius, height, rotation } => {
             let d = 2.0 * radius;
             entity.cylinders.push(Cylinder {
-                pose: Pose::at(center),
+                pose: Pose::new(center, &UnitQuaternion::from_rotation_matrix(rotation)),
                 size: Xyz { x: d, y: d, z: *height },
                 bottom_scale: 1.0,
                 top_scale: 1.0,

@@ -315,10 +315,12 @@ class Task:
     @property
     def scene(self) -> list[dict[str, Any]]:
         """The obstacles, each a dict with ``"name"``, ``"shape"`` and the
-        shape's fields: ``box`` (``center``, ``size``: full edge lengths),
-        ``sphere`` (``center``, ``radius``), ``capsule`` (``a``, ``b``,
-        ``radius``), ``cylinder`` (``center``, ``radius``, ``height``);
-        points are arrays of shape (3,), lengths floats (m)."""
+        shape's fields: ``box`` (``center``, ``size``: full edge lengths
+        along its own axes, ``rotation``), ``sphere`` (``center``,
+        ``radius``), ``capsule`` (``a``, ``b``, ``radius``), ``cylinder``
+        (``center``, ``radius``, ``height``, ``rotation``: its own z is the
+        axis); points are arrays of shape (3,), rotations (3, 3) arrays (the
+        shape's axes as columns), lengths floats (m)."""
 
     @property
     def settings(self) -> dict[str, Any]:

@@ -690,34 +690,52 @@ fn circle(centre: (Real, Real), radius: Real) -> Vec<(Real, Real)> {
 pub fn outline(o: &Obstacle, h: usize, v: usize) -> Vec<Vec<(Real, Real)>> {
     let at = |p: &Vector3| (p[h], p[v]);
     match &o.shape {
-        Shape::Box { center, size } => {
-            let (cx, cy) = at(center);
-            let (hx, hy) = (0.5 * size[h], 0.5 * size[v]);
-            vec![vec![
-                (cx - hx, cy - hy),
-                (cx + hx, cy - hy),
-                (cx + hx, cy + hy),
-                (cx - hx, cy + hy),
-            ]]
+        Shape::Box { center, size, rotation } => {
+            let corners = (0..8).map(|k| {
+                let corner = Vector3::from_fn(|i, _| {
+                    if k >> i & 1 == 1 { 0.5 * size[i] } else { -0.5 * size[i] }
+                });
+                at(&(center + rotation * corner))
+            });
+            vec![hull(corners.collect())]
         }
         Shape::Sphere { center, radius } => vec![circle(at(center), *radius)],
-        Shape::Cylinder { center, radius, height } => {
-            if h != 2 && v != 2 {
-                vec![circle(at(center), *radius)]
-            } else {
-                let (cx, cy) = at(center);
-                let half = |axis: usize| if axis == 2 { 0.5 * height } else { *radius };
-                let (hx, hy) = (half(h), half(v));
-                vec![vec![
-                    (cx - hx, cy - hy),
-                    (cx + hx, cy - hy),
-                    (cx + hx, cy + hy),
-                    (cx - hx, cy + hy),
-                ]]
-            }
+        Shape::Cylinder { center, radius, height, rotation } => {
+            // The hull of the two rims.
+            let rims = (0..96).map(|k| {
+                let a = std::f64::consts::TAU * (k % 48) as Real / 48.0;
+                let z = if k < 48 { -0.5 * height } else { 0.5 * height };
+                let local = Vector3::new(radius * a.cos(), radius * a.sin(), z);
+                at(&(center + rotation * local))
+            });
+            vec![hull(rims.collect())]
         }
         Shape::Capsule { a, b, radius } => vec![stadium(at(a), at(b), *radius)],
     }
+}
+
+/// The convex hull of `points`, counter-clockwise (Andrew's monotone chain).
+fn hull(mut points: Vec<(Real, Real)>) -> Vec<(Real, Real)> {
+    points.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let turn = |o: (Real, Real), a: (Real, Real), b: (Real, Real)| {
+        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+    };
+    let mut out: Vec<(Real, Real)> = Vec::with_capacity(points.len() + 1);
+    for pass in [false, true] {
+        let start = out.len();
+        let ordered: Box<dyn Iterator<Item = &(Real, Real)>> =
+            if pass { Box::new(points.iter().rev()) } else { Box::new(points.iter()) };
+        for &p in ordered {
+            while out.len() >= start + 2 && turn(out[out.len() - 2], out[out.len() - 1], p) <= 1e-15
+            {
+                out.pop();
+            }
+            out.push(p);
+        }
+        // Each chain's last point starts the other.
+        out.pop();
+    }
+    out
 }
 
 /// The outline of a segment thickened by `radius`: two half circles joined.
