@@ -460,19 +460,20 @@ def test_auto_gives_a_goal_among_obstacles_to_the_rrt() -> None:
     assert again == report and again.rrt == report.rrt
 
 
-def test_auto_goes_on_to_the_rrt_when_the_qp_leaves_a_hard_path() -> None:
-    """Paper §6.2: round the forward bar the QP leaves the wrist's line; the
-    constrained RRT keeps it exactly."""
+def test_auto_goes_on_to_the_rrt_when_the_qp_stalls_on_a_hard_path() -> None:
+    """Paper §6.2: the QP keeps the wrist's line and the forward bar stops it
+    there, short of the goal; the constrained RRT reaches the goal on it."""
     path = EXAMPLES / "type_iv_forward_bar.a2ml"
     qp = a2ml.plan(path, solver="qp").segments[0]
-    assert qp.hard_path and not qp.path_kept and qp.fallback is None
-    assert qp.path_errors["pw"].error > 0.01
+    assert qp.hard_path and qp.path_kept and qp.fallback is None
+    assert qp.stalled and not qp.reached
+    assert qp.path_errors["pw"].error < 1e-3
     auto = a2ml.plan(path, solver="auto")
     segment = auto.segments[0]
-    assert (segment.solver, segment.fallback) == ("rrt", "qp_left_path")
+    assert (segment.solver, segment.fallback) == ("rrt", "qp_stalled")
     assert segment.path_kept and segment.reached and auto.reached
     assert segment.path_errors["pw"].error < 1e-9
-    assert segment.to_dict()["fallback"] == "qp_left_path"
+    assert segment.to_dict()["fallback"] == "qp_stalled"
     assert pickle.loads(pickle.dumps(segment)) == segment
 
 

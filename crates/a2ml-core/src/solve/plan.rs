@@ -701,12 +701,13 @@ impl Solver<'_> {
     }
 
     fn qp(&self, job: &Job, monitor: &mut Monitor) -> Result<Solved, SolveError> {
+        let options = QpOptions { hard_path: job.hard, ..self.qp };
         let solution = qp::solve_segment_monitored(
             self.robot,
             job.scene,
             &job.problem,
             &self.q,
-            &self.qp,
+            &options,
             monitor,
         )
         .map_err(|source| SolveError::Qp {

@@ -80,6 +80,13 @@ pub struct QpOptions {
     pub rest_speed: Real,
     /// When the goal counts as reached.
     pub tolerance: Tolerance,
+    /// Keep the path components on their path as constraints, not weighted rows: the
+    /// segment's path is hard. Their velocity normal to the path is then the feedback towards
+    /// it, so the arm moves along the path or stops on it, giving up progress and the goals
+    /// instead (paper §6.2); a step whose bounds and damper rows leave no such velocity keeps
+    /// them and lets the path go (the judgement of the result reports it). Default false;
+    /// [`super::plan`] sets it for the segments that carry an action's hard path.
+    pub hard_path: bool,
 }
 
 impl Default for QpOptions {
@@ -100,9 +107,17 @@ impl Default for QpOptions {
             max_settle: 1.0,
             rest_speed: 5e-4,
             tolerance: Tolerance::default(),
+            hard_path: false,
         }
     }
 }
+
+/// Half the width of the slab a·x ∈ [b - ε, b + ε] each equality of a hard path is written
+/// as (m/s or rad/s): negligible against the feedback towards the path, thick enough for the
+/// interior-point solver's tolerances.
+const PATH_SLACK: Real = 1e-6;
+/// Step in σ of the central difference giving the path's tangent.
+const TANGENT_STEP: Real = 1e-6;
 
 /// Why a segment cannot be solved.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -277,6 +292,8 @@ struct Controller<'a> {
     scene: &'a CollisionScene,
     /// The segment's problem; once the loop stops while moving, the hold of where it stopped.
     problem: SegmentProblem,
+    /// The segment's own components, whose hard path holds while braking too.
+    path: [Component; 3],
     options: &'a QpOptions,
     weights: WeightSchedule,
     lower: JointVector,
@@ -306,6 +323,7 @@ impl<'a> Controller<'a> {
             robot,
             scene,
             weights: WeightSchedule::new(problem.duration, options.weights),
+            path: problem.components,
             problem,
             options,
             lower: robot.lower(),
@@ -340,26 +358,98 @@ impl<'a> Controller<'a> {
         let p = jacobian.transpose() * weighted + Matrix7::identity() * self.options.regularization;
         let c = weighted.transpose() * target;
         let (lower, upper) = self.bounds(q);
-        let (ramp_lower, ramp_upper) = self.ramp(&lower, &upper, current);
-        let rows = self.damper_rows(pose);
-
-        let cholesky = p.cholesky();
-        let exact = |lower: &Vector7, upper: &Vector7| {
-            cholesky.as_ref().and_then(|ch| structured_solve(ch, &c, lower, upper, &rows))
-        };
-        let (velocity, clarabel) = match exact(&ramp_lower, &ramp_upper) {
-            Some(x) => (x, false),
-            None => match self.clarabel_solve(&p, &c, &ramp_lower, &ramp_upper, &rows, t) {
-                Ok(x) => (x, true),
-                // The damper rows cannot hold within the acceleration box: keep the rows.
-                Err(_) => match exact(&lower, &upper) {
-                    Some(x) => (x, false),
-                    None => (self.clarabel_solve(&p, &c, &lower, &upper, &rows, t)?, true),
-                },
-            },
+        let ramp = self.ramp(&lower, &upper, current);
+        let mut rows = self.damper_rows(pose);
+        let dampers = rows.len();
+        if self.options.hard_path {
+            rows.extend(self.path_rows(&jacobian, &values));
+        }
+        let (velocity, clarabel) = match self.solve_step(&p, &c, (&lower, &upper), ramp, &rows, t) {
+            // No velocity keeps the path within the bounds and the damper rows: keep those.
+            Err(_) if rows.len() > dampers => {
+                rows.truncate(dampers);
+                self.solve_step(&p, &c, (&lower, &upper), ramp, &rows, t)?
+            }
+            solved => solved?,
         };
         self.timing.record(started.elapsed().as_secs_f64(), clarabel);
         Ok(Step { velocity, errors })
+    }
+
+    /// The step QP's solution within the acceleration box `ramp` when it holds with the rows,
+    /// else within the velocity box `bounds` (the rows kept); whether Clarabel was needed.
+    fn solve_step(
+        &mut self,
+        p: &Matrix7,
+        c: &Vector7,
+        (lower, upper): (&Vector7, &Vector7),
+        (ramp_lower, ramp_upper): (Vector7, Vector7),
+        rows: &[(Vector7, Real)],
+        t: Real,
+    ) -> Result<(Vector7, bool), QpError> {
+        let cholesky = p.cholesky();
+        let exact = |lower: &Vector7, upper: &Vector7| {
+            cholesky.as_ref().and_then(|ch| structured_solve(ch, c, lower, upper, rows))
+        };
+        Ok(match exact(&ramp_lower, &ramp_upper) {
+            Some(x) => (x, false),
+            None => match self.clarabel_solve(p, c, &ramp_lower, &ramp_upper, rows, t) {
+                Ok(x) => (x, true),
+                // The rows cannot hold within the acceleration box: keep the rows.
+                Err(_) => match exact(lower, upper) {
+                    Some(x) => (x, false),
+                    None => (self.clarabel_solve(p, c, lower, upper, rows, t)?, true),
+                },
+            },
+        })
+    }
+
+    /// A hard path as equality rows, each written as the slab a·x ≤ b + ε, -a·x ≤ -b + ε
+    /// ([`PATH_SLACK`]): along every direction n normal to the path at the point nearest the
+    /// arm (the path components stacked, σ shared), nᵀ J_path q' = gain · nᵀ (nearest - now).
+    /// Motion along the path is left to the weighted rows; a path that does not move (a hold)
+    /// is kept in every direction. The segment's path, also while the arm brakes.
+    fn path_rows(&self, jacobian: &Matrix7, values: &[Target; 3]) -> Vec<(Vector7, Real)> {
+        let components = &self.path;
+        let mut offsets = [0; 3];
+        let mut row = 0;
+        for (k, c) in components.iter().enumerate() {
+            offsets[k] = row;
+            row += width(c.variable);
+        }
+        let path: Vec<usize> = (0..3).filter(|&k| components[k].role == Role::Path).collect();
+        let sigma = path
+            .iter()
+            .find_map(|&k| components[k].reference.nearest_fraction(&values[k]))
+            .map_or(0.0, |s| s.clamp(0.0, 1.0));
+        let m: usize = path.iter().map(|&k| width(components[k].variable)).sum();
+        let mut jacobian_path = nalgebra::DMatrix::<Real>::zeros(m, DOF);
+        let mut error = nalgebra::DVector::<Real>::zeros(m);
+        let mut tangent = nalgebra::DVector::<Real>::zeros(m);
+        let mut r = 0;
+        for &k in &path {
+            let c = &components[k];
+            let w = width(c.variable);
+            let at = |s: Real| c.reference.at_fraction(s);
+            let towards = difference(c.variable, &at(sigma), &values[k]);
+            let (ahead, behind) = (at(sigma + TANGENT_STEP), at(sigma - TANGENT_STEP));
+            let along = difference(c.variable, &ahead, &behind) / (2.0 * TANGENT_STEP);
+            for i in 0..w {
+                jacobian_path.set_row(r + i, &jacobian.row(offsets[k] + i));
+                error[r + i] = towards[i];
+                tangent[r + i] = along[i];
+            }
+            r += w;
+        }
+        let gain = self.options.gain;
+        normal_basis(&tangent)
+            .iter()
+            .flat_map(|n| {
+                let a = Vector7::from_iterator((n.transpose() * &jacobian_path).iter().copied());
+                let b = gain * n.dot(&error);
+                [(a, b + PATH_SLACK), (-a, -b + PATH_SLACK)]
+            })
+            .collect()
     }
 
     /// The Jacobian of the segment's space and the current values of its variables.
@@ -580,6 +670,42 @@ impl Resolver for Controller<'_> {
         let braking = (velocity.component_div(&self.acceleration).amax() / step).ceil() as usize;
         Ok(Some(settle_steps.max(1) + braking))
     }
+}
+
+/// `to - from` in a variable's rows of the Jacobian: the difference of positions, the spatial
+/// rotation vector log(to fromᵀ), the angle difference (the swivel angle wrapped); angles
+/// in the first entry.
+fn difference(variable: Variable, to: &Target, from: &Target) -> crate::math::Vector3 {
+    match (to, from) {
+        (Target::Position(a), Target::Position(b)) => a - b,
+        (Target::Rotation(a), Target::Rotation(b)) => rotation_log(&(a * b.inverse())),
+        (Target::Angle(a), Target::Angle(b)) => {
+            let d = if variable == Variable::Swivel { wrap_angle(a - b) } else { a - b };
+            crate::math::Vector3::new(d, 0.0, 0.0)
+        }
+        _ => crate::math::Vector3::zeros(),
+    }
+}
+
+/// An orthonormal basis of the directions normal to `tangent`: the last m - 1 columns of the
+/// Householder reflection taking the first axis to it (all m axes for a zero tangent).
+fn normal_basis(tangent: &nalgebra::DVector<Real>) -> Vec<nalgebra::DVector<Real>> {
+    let m = tangent.len();
+    let length = tangent.norm();
+    if length <= 1e-12 {
+        return (0..m).map(|i| nalgebra::DVector::from_fn(m, |j, _| if i == j { 1.0 } else { 0.0 })).collect();
+    }
+    let u = tangent / length;
+    // v = u ∓ e1, the sign that keeps v away from zero.
+    let mut v = u.clone();
+    v[0] += if u[0] > 0.0 { 1.0 } else { -1.0 };
+    let vv = v.norm_squared();
+    (1..m)
+        .map(|i| {
+            let e = nalgebra::DVector::from_fn(m, |j, _| if i == j { 1.0 } else { 0.0 });
+            &e - &v * (2.0 * v[i] / vv)
+        })
+        .collect()
 }
 
 /// The QP's solution when its structure gives it exactly, else `None` (then Clarabel decides).
