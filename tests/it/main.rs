@@ -1,6 +1,7 @@
 //! Integration tests of the a2ml library, one module per area.
 
 mod baselines;
+mod clearance;
 mod collision;
 mod common;
 mod constrained_rrt;
