@@ -14,6 +14,8 @@ mod jacobians;
 mod language;
 mod metrics;
 mod map;
+mod mbm;
+mod mbm_problems;
 mod opt;
 mod output;
 mod plan;
