@@ -1,6 +1,7 @@
 //! Integration tests of the a2ml library, one module per area.
 
 mod baselines;
+mod clearance;
 mod collision;
 mod common;
 mod constrained_rrt;
@@ -13,6 +14,8 @@ mod jacobians;
 mod language;
 mod metrics;
 mod map;
+mod mbm;
+mod mbm_problems;
 mod opt;
 mod output;
 mod plan;

@@ -198,12 +198,17 @@ impl CollisionModel {
             // Only distances (between the segment and an obstacle's core) below this may lower
             // `best`; it falls to the nearest found.
             let mut below = offset + loose(&capsule.levers).threshold(best) + link.radius;
+            // Whether an obstacle was found below the bound: without one, the capsule cannot
+            // lower `best`, and the bound itself is no distance (rounded, it can even put a
+            // capsule that cannot move a hair inside the clearance).
+            let mut found = false;
             for sphere in &self.spheres {
                 let reach = below + sphere.radius;
                 if reach > 0.0 {
                     let squared = link.squared_distance_to_point(&sphere.center);
                     if squared < reach * reach {
                         below = squared.sqrt() - sphere.radius;
+                        found = true;
                     }
                 }
             }
@@ -214,6 +219,7 @@ impl CollisionModel {
                         segment_segment_distance(&link.a, &link.b, &capsule.a, &capsule.b);
                     if distance < reach {
                         below = distance - capsule.radius;
+                        found = true;
                     }
                 }
             }
@@ -221,9 +227,15 @@ impl CollisionModel {
                 let gap = (link.center - body.center).norm() - link.bound - body.bound;
                 if gap < below - link.radius {
                     if let Some(distance) = link.convex_distance(body, below) {
-                        below = below.min(distance);
+                        if distance < below {
+                            below = distance;
+                            found = true;
+                        }
                     }
                 }
+            }
+            if !found {
+                continue;
             }
             let slack = below - link.radius - offset;
             if loose(&capsule.levers).reach(slack) < best {
