@@ -277,7 +277,11 @@ impl Chart {
     /// reachable; with its IK solution nearest that joint-space sample, which tells the
     /// trees which IK branch the point is wanted on. `None` when the sample's state is
     /// singular, no swivel angle works or the point has no IK solution.
-    pub(crate) fn sample(&self, robot: &Robot, rng: &mut StdRng) -> Option<(ChartPoint, JointVector)> {
+    pub(crate) fn sample(
+        &self,
+        robot: &Robot,
+        rng: &mut StdRng,
+    ) -> Option<(ChartPoint, JointVector)> {
         let (lower, upper) = (robot.lower(), robot.upper());
         let q = JointVector::from_fn(|i, _| rng.random_range(lower[i]..=upper[i]));
         let x = self.sample_near(robot, &q, rng)?;

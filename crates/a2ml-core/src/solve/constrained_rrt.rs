@@ -119,8 +119,14 @@ pub fn constrained_rrt_monitored(
     }
     let from_start = Tree::of_roots([start_node]);
     let from_goal = Tree::of_roots(goal_nodes);
-    let connected =
-        connect_trees(&mut search, from_start, from_goal, &mut rng, options.max_samples, &mut monitor)?;
+    let connected = connect_trees(
+        &mut search,
+        from_start,
+        from_goal,
+        &mut rng,
+        options.max_samples,
+        &mut monitor,
+    )?;
     let path = connected.path.iter().map(|n| (n.x, n.q)).collect();
     Ok(search.finish(path, &mut rng, connected.samples, connected.nodes))
 }
@@ -329,7 +335,6 @@ impl<'a> Search<'a> {
         let (waypoints, configurations) = path.into_iter().unzip();
         ConstrainedPath { waypoints, configurations, tracks, stats }
     }
-
 }
 
 /// A node of a chart tree: its chart point, the IK solution tracked there and its clearance.

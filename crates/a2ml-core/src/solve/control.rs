@@ -353,7 +353,8 @@ pub fn run_monitored<R: Resolver>(
                 for i in 0..n {
                     let s = t + i as Real * d;
                     let v = velocity;
-                    let k1 = if i == 0 { now.velocity } else { call(resolver, &p, &v, s)?.velocity };
+                    let k1 =
+                        if i == 0 { now.velocity } else { call(resolver, &p, &v, s)?.velocity };
                     let k2 = call(resolver, &(p + k1 * (d / 2.0)), &v, s + d / 2.0)?.velocity;
                     let k3 = call(resolver, &(p + k2 * (d / 2.0)), &v, s + d / 2.0)?.velocity;
                     let k4 = call(resolver, &(p + k3 * d), &v, s + d)?.velocity;

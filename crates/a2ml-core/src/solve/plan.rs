@@ -11,14 +11,14 @@
 use std::time::Instant;
 
 use super::assembly::Assembly;
-use super::checks::{self, CheckError};
 use super::chart::Chart;
+use super::checks::{self, CheckError};
 use super::constrained_rrt::constrained_rrt_monitored;
 use super::control::{BaselineOptions, ControlError, ControlOptions, ControlRun};
 use super::hamp::{HampOptions, HandoverTarget, plan_handover};
+use super::judge::{self, Judgement};
 use super::map::{MapError, MapOptions, map_segment};
 use super::monitor::{Monitor, deadline_after};
-use super::judge::{self, Judgement};
 use super::problem::{Component, SegmentProblem};
 use super::qp::{self, QpError, QpOptions};
 use super::report::{Fallback, Plan, QpStats, SegmentReport, Tolerance, VariableError};

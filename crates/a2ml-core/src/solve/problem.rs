@@ -35,4 +35,3 @@ pub(crate) fn width(variable: Variable) -> usize {
         Variable::Pw | Variable::Ow | Variable::Os => 3,
     }
 }
-

@@ -35,8 +35,7 @@ pub use super::problem::{Component, SegmentProblem};
 use super::report::{QpStats, Tolerance};
 use crate::collision::{self, CollisionScene, DistanceOptions, Proximity};
 use crate::kinematics::{
-    ArmPose, KinematicsError, cpsa_jacobian, cpsa_state, hat_jacobian, hat_state,
-    point_jacobian,
+    ArmPose, KinematicsError, cpsa_jacobian, cpsa_state, hat_jacobian, hat_state, point_jacobian,
 };
 use crate::language::{Space, Target, Variable};
 use crate::math::{DOF, JointVector, Matrix7, Real, Vector7, rotation_log, wrap_angle};
@@ -224,7 +223,14 @@ pub fn solve_segment_monitored(
 ) -> Result<QpSolution, QpError> {
     check_options(options)?;
     let mut controller = Controller::new(robot, scene, problem.clone(), options);
-    let run = run_monitored(robot, &mut controller, q0, problem.duration, &control_options(options), monitor)?;
+    let run = run_monitored(
+        robot,
+        &mut controller,
+        q0,
+        problem.duration,
+        &control_options(options),
+        monitor,
+    )?;
     let errors = controller.errors;
     Ok(QpSolution {
         trajectory: run.trajectory,
@@ -616,7 +622,6 @@ impl<'a> Controller<'a> {
             duration,
         })
     }
-
 }
 
 impl Resolver for Controller<'_> {
@@ -637,11 +642,8 @@ impl Resolver for Controller<'_> {
             }
             self.errors = step.errors;
         }
-        let units = judge::tolerance_units(
-            &self.options.tolerance,
-            &self.problem.components,
-            &step.errors,
-        );
+        let units =
+            judge::tolerance_units(&self.options.tolerance, &self.problem.components, &step.errors);
         Ok(Resolved { velocity: step.velocity, error: units.iter().copied().fold(0.0, Real::max) })
     }
 
@@ -693,7 +695,9 @@ fn normal_basis(tangent: &nalgebra::DVector<Real>) -> Vec<nalgebra::DVector<Real
     let m = tangent.len();
     let length = tangent.norm();
     if length <= 1e-12 {
-        return (0..m).map(|i| nalgebra::DVector::from_fn(m, |j, _| if i == j { 1.0 } else { 0.0 })).collect();
+        return (0..m)
+            .map(|i| nalgebra::DVector::from_fn(m, |j, _| if i == j { 1.0 } else { 0.0 }))
+            .collect();
     }
     let u = tangent / length;
     // v = u ∓ e1, the sign that keeps v away from zero.

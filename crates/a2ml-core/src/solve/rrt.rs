@@ -211,8 +211,14 @@ pub fn rrt_connect_monitored(
     let from_goal =
         Tree::of_roots(valid_goals.iter().map(|&(index, q)| Node { q, goal: Some(index) }));
     let mut rng = StdRng::seed_from_u64(options.seed);
-    let connected =
-        connect_trees(&mut space, from_start, from_goal, &mut rng, options.max_samples, &mut monitor)?;
+    let connected = connect_trees(
+        &mut space,
+        from_start,
+        from_goal,
+        &mut rng,
+        options.max_samples,
+        &mut monitor,
+    )?;
     let goal = connected.path.last().and_then(|n| n.goal).unwrap_or(0);
     let waypoints = connected.path.into_iter().map(|n| n.q).collect();
     let waypoints = shortcut(waypoints, &mut space, &mut rng, options.shortcuts);
@@ -341,7 +347,6 @@ impl<'a> JointSpace<'a> {
         }
         true
     }
-
 }
 
 /// A node of a joint-space tree: its configuration, and for a goal tree's root which goal it
@@ -430,4 +435,3 @@ fn shortcut(
 pub fn path_length(waypoints: &[JointVector]) -> Real {
     waypoints.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
 }
-

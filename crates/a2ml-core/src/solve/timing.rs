@@ -105,7 +105,6 @@ pub fn time_parameterise(
     Ok(TimedPath { trajectory, duration: total, stretched: total > duration * (1.0 + 1e-9) })
 }
 
-
 /// A chart edge and the configurations checked along it (edge fraction, joints).
 struct Edge {
     a: ChartPoint,
@@ -297,6 +296,9 @@ pub fn time_constrained(
     })
 }
 
+/// Samples of a motion: times, q, q'.
+type Samples = (Vec<Real>, Vec<JointVector>, Vec<JointVector>);
+
 /// One piece timed by a rest-to-rest bell of `duration` over its `length`: times from 0, q,
 /// q'.
 fn time_piece(
@@ -306,7 +308,7 @@ fn time_piece(
     length: Real,
     duration: Real,
     rate: Real,
-) -> Result<(Vec<Real>, Vec<JointVector>, Vec<JointVector>), RrtError> {
+) -> Result<Samples, RrtError> {
     let bell = BellProfile::new(duration, length)
         .map_err(|e| RrtError::Timing { reason: TrajectoryError::Join(e).to_string() })?;
     let times = sample_times(0.0, duration, rate);

@@ -142,7 +142,11 @@ fn nearest_node<S: TreeSpace>(tree: &Tree<S::Node>, target: &S::Target) -> usize
 }
 
 /// One step from the nearest node towards a sample: the new node, if any.
-fn extend<S: TreeSpace>(space: &mut S, tree: &mut Tree<S::Node>, target: &S::Target) -> Option<usize> {
+fn extend<S: TreeSpace>(
+    space: &mut S,
+    tree: &mut Tree<S::Node>,
+    target: &S::Target,
+) -> Option<usize> {
     let near = nearest_node::<S>(tree, target);
     match step(space, tree, near, target, true) {
         Extension::Reached(i) | Extension::Advanced(i) => Some(i),
@@ -224,10 +228,8 @@ pub(crate) fn connect_trees<S: TreeSpace>(
         }
         swapped = !swapped;
     }
-    let closest = closest_pair(
-        from_start.nodes.iter().map(S::joints),
-        from_goal.nodes.iter().map(S::joints),
-    );
+    let closest =
+        closest_pair(from_start.nodes.iter().map(S::joints), from_goal.nodes.iter().map(S::joints));
     let nodes = from_start.nodes.len() + from_goal.nodes.len();
     Err(RrtError::NoPath { closest, stats: space.stats(samples, nodes) })
 }

@@ -180,7 +180,7 @@ impl WristMotion {
         let find = |v: Variable| problem.components.iter().find(|c| c.variable == v);
         match (problem.space, find(Variable::Pw), find(Variable::Ow)) {
             (Space::Cpsa, Some(pw), Some(ow)) => {
-                Ok(Self::References { pw: pw.reference.clone(), ow: ow.reference.clone() })
+                Ok(Self::References { pw: pw.reference, ow: ow.reference })
             }
             _ => Err(MapError::NotWristSegment),
         }
