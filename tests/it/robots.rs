@@ -437,3 +437,22 @@ fn an_arm_without_geometry_is_covered_by_its_skeleton_or_refused() {
     let err = a2ml::solve::plan(&bare, &task, &a2ml::solve::PlanOptions::default()).unwrap_err();
     assert!(matches!(err, a2ml::solve::SolveError::NoArmGeometry { .. }), "{err:?}");
 }
+
+#[test]
+fn a_task_loads_the_chain_its_robot_line_names() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/tasks/baxter_left_reach.a2ml");
+    let task = a2ml::language::load(&path).expect("the task is valid");
+    assert!(a2ml::Robot::from_urdf_file(&task.robot).is_err(), "two arms: no unique chain");
+    let left = task.load_robot(&a2ml::RobotOptions::default()).expect("the left arm");
+    assert_eq!((left.base_link.as_str(), left.tip_link.as_str()), ("left_arm_mount", "left_wrist"));
+    assert!(left.joints.iter().all(|j| j.name.starts_with("left_")));
+    // Options that name a chain win over the task's.
+    let options = a2ml::RobotOptions {
+        base: Some("right_arm_mount".into()),
+        tip: Some("right_wrist".into()),
+        ..a2ml::RobotOptions::default()
+    };
+    let right = task.load_robot(&options).expect("the right arm");
+    assert!(right.joints.iter().all(|j| j.name.starts_with("right_")));
+}

@@ -5,6 +5,7 @@
 //! Everything else lives in [`commands`] and the core library.
 
 mod args;
+mod batch;
 mod commands;
 mod error;
 mod output;

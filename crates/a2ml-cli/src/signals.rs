@@ -67,8 +67,8 @@ impl Temporaries {
     /// already in place.
     pub fn commit_all(&self, staged: Vec<Staged>) -> Result<(), OutputError> {
         let mut paths = self.lock();
-        let result = staged.into_iter().try_for_each(Staged::commit);
-        paths.clear();
-        result
+        // Only these files' entries go: other tasks of a batch may be staging theirs.
+        paths.retain(|p| !staged.iter().any(|s| s.temporary() == p));
+        staged.into_iter().try_for_each(Staged::commit)
     }
 }

@@ -11,7 +11,7 @@ use pyo3::types::PyDict;
 
 use crate::language::{self, PyTask};
 use crate::plan::{solver_choice, task_path};
-use crate::{CoreError, PyRobot};
+use crate::PyRobot;
 
 /// The default solvers: A2ML's own policy and the three baselines.
 const DEFAULT_SOLVERS: [SolverChoice; 4] =
@@ -39,8 +39,7 @@ pub(crate) fn compare<'py>(
     let robot = match robot {
         Some(robot) => robot.unbind(),
         None => {
-            let loaded = py.detach(|| a2ml_core::Robot::from_urdf_file(&task.robot));
-            Py::new(py, PyRobot::new(loaded.map_err(CoreError::from)?))?
+            Py::new(py, PyRobot::of_task(py, task)?)?
         }
     };
     let robot = &robot.get().robot;

@@ -34,7 +34,7 @@ pub(crate) fn decompose<'py>(
             let robot = match robot {
                 Some(r) => r,
                 None => {
-                    loaded = a2ml_core::Robot::from_urdf_file(&task.robot)?;
+                    loaded = task.load_robot(&a2ml_core::RobotOptions::default())?;
                     &loaded
                 }
             };

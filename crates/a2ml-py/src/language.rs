@@ -18,10 +18,11 @@ use a2ml_core::language::{
     PathFeature, PathItem, PositionFrame, Primitive, PrimitiveConstraint, Segment, Settings, Shape,
     Space, Start, Target, Variable,
 };
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple};
 
-use crate::{CoreError, os_error, to_rotation, to_vector};
+use crate::{CoreError, os_error, read_angle, read_rotation, read_vector3, to_rotation, to_vector};
 
 type Dict<'py> = Bound<'py, PyDict>;
 
@@ -117,6 +118,45 @@ impl PyTask {
     #[getter]
     fn path(&self) -> Option<String> {
         self.path_text()
+    }
+
+    /// A new task, this one with the goal values of `action` replaced: keyword arguments
+    /// named as the `Robot` methods name variables (`pw`: (3,) position in m; `ow`, `os`:
+    /// (3, 3) rotations; `swivel`, `elbow`: angles in rad), in the task's frame. Only a goal
+    /// the action states can change. The new task is the old text with those values, printed
+    /// canonically, validated; it pickles and is attached to outputs as any task.
+    #[pyo3(signature = (action, **goal))]
+    fn with_goal(
+        &self,
+        py: Python<'_>,
+        action: &str,
+        goal: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<PyTask> {
+        let mut goals = Vec::new();
+        for (name, value) in goal.into_iter().flat_map(|d| d.iter()) {
+            let name: String = name.extract()?;
+            let variable = variable_from_name(&name).ok_or_else(|| {
+                PyTypeError::new_err(format!(
+                    "with_goal() got an unexpected keyword argument '{name}' \
+                     (variables: pw, ow, swivel, os, elbow)"
+                ))
+            })?;
+            let target = match variable {
+                Variable::Pw => Target::Position(read_vector3(&value, &name)?),
+                Variable::Ow | Variable::Os => Target::Rotation(read_rotation(&value, &name)?),
+                Variable::Swivel | Variable::Elbow => {
+                    Target::Angle(read_angle(value.extract()?, &name)?)
+                }
+            };
+            goals.push((variable, target));
+        }
+        let path = self.path.as_deref();
+        let text =
+            language::with_goal(&self.source, path, action, &goals).map_err(|e| match e {
+                language::EditError::Syntax(d) => CoreError::from(d).into(),
+                other => PyValueError::new_err(other.to_string()),
+            })?;
+        parse(py, text, self.path.clone())
     }
 
     /// Every field above except `source` and `path`, as one dict.

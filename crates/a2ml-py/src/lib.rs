@@ -313,9 +313,12 @@ pub(crate) struct PyRobot {
 }
 
 impl PyRobot {
-    /// A robot loaded by the core with the default chain options.
-    pub(crate) fn new(robot: a2ml_core::Robot) -> Self {
-        Self { robot, base: None, tip: None }
+    /// A task's robot, loaded with its `base` and `tip` (which it keeps, to pickle), releasing
+    /// the GIL.
+    pub(crate) fn of_task(py: Python<'_>, task: &a2ml_core::language::Task) -> PyResult<Self> {
+        let robot = py.detach(|| task.load_robot(&RobotOptions::default()));
+        let (base, tip) = (task.robot_base.clone(), task.robot_tip.clone());
+        Ok(Self { robot: robot.map_err(CoreError::from)?, base, tip })
     }
 
     fn options(base: &Option<String>, tip: &Option<String>) -> RobotOptions {
@@ -583,6 +586,7 @@ fn _a2ml(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<plan::PyPlan>()?;
     m.add_class::<plan::PySegmentReport>()?;
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
+    m.add_function(wrap_pyfunction!(plan::plan_many, m)?)?;
     m.add_function(wrap_pyfunction!(compare::compare, m)?)?;
     m.add_function(wrap_pyfunction!(map::swivel_map, m)?)?;
     m.add_function(wrap_pyfunction!(metrics::_metrics_analyze, m)?)?;

@@ -111,7 +111,7 @@ pub(crate) fn swivel_map<'py>(
         return Err(PyValueError::new_err("segment counts from 1"));
     }
     let result = py.detach(|| {
-        let robot = a2ml_core::Robot::from_urdf_file(&task.robot)
+        let robot = task.load_robot(&a2ml_core::RobotOptions::default())
             .map_err(|e| e.to_string())?;
         segment_map(&robot, &task, action, segment - 1, &DecomposeOptions::default(), &options)
             .map_err(|e| e.to_string())

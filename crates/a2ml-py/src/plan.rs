@@ -8,6 +8,7 @@
 //! because the core types serialize but do not deserialize.
 
 use std::borrow::Cow;
+use std::collections::HashMap;
 use std::path::PathBuf;
 
 use a2ml_core::decompose::{ActionType, SegmentPattern};
@@ -20,9 +21,10 @@ use a2ml_core::trajectory::{Clearance, Trajectory};
 use numpy::IntoPyArray;
 use numpy::ndarray::Array2;
 use pyo3::call::PyCallArgs;
-use pyo3::exceptions::{PyKeyError, PyTypeError, PyValueError};
+use pyo3::exceptions::{PyKeyError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString, PyTuple, PyType};
+use pyo3::types::{PyBytes, PyDict, PyString, PyTuple, PyType};
+use rayon::prelude::*;
 
 use crate::language::{self, PyTask, space_from_name, space_name, variable_from_name};
 use crate::{CoreError, Matrix, PyRobot, Vector, read_array, to_vector};
@@ -49,33 +51,133 @@ pub(crate) fn plan(
         Ok(task) => task.clone(),
         Err(_) => Bound::new(py, language::load(py, task_path(task_or_path)?)?)?,
     };
-    let options = PlanOptions {
-        solver: solver.map(solver_choice).transpose()?,
-        rate,
-        acceleration_scale,
-        time_limit,
-        ..PlanOptions::default()
-    };
-    let planned_task = match seed {
-        Some(seed) => {
-            let mut seeded = task.get().task.clone();
-            seeded.settings.seed = seed;
-            Cow::Owned(seeded)
-        }
-        None => Cow::Borrowed(&task.get().task),
-    };
+    let options = plan_options(solver, rate, acceleration_scale, time_limit)?;
+    let planned_task = seeded(&task.get().task, seed);
     let robot = match robot {
         Some(robot) => robot.unbind(),
         None => {
-            let urdf = &planned_task.robot;
-            let loaded = py.detach(|| a2ml_core::Robot::from_urdf_file(urdf));
-            Py::new(py, PyRobot::new(loaded.map_err(CoreError::from)?))?
+            Py::new(py, PyRobot::of_task(py, &planned_task)?)?
         }
     };
     let planned = py
         .detach(|| solve::plan(&robot.get().robot, &planned_task, &options))
         .map_err(CoreError::from)?;
     Ok(PyPlan { plan: planned, robot, task: task.unbind() })
+}
+
+/// Plans many tasks (Tasks or paths) on `jobs` threads (default: every core), releasing the
+/// GIL: one entry per task, in input order, a Plan or the exception `plan` would have raised.
+/// Robots are loaded once each (`robot`, else each task's robot with its base and tip).
+#[pyfunction]
+#[pyo3(signature = (
+    tasks, robot=None, jobs=None, solver=None, rate=None, seed=None, acceleration_scale=None,
+    time_limit=None
+))]
+pub(crate) fn plan_many(
+    py: Python<'_>,
+    tasks: &Bound<'_, PyAny>,
+    robot: Option<Bound<'_, PyRobot>>,
+    jobs: Option<usize>,
+    solver: Option<&str>,
+    rate: Option<Real>,
+    seed: Option<u64>,
+    acceleration_scale: Option<Real>,
+    time_limit: Option<Real>,
+) -> PyResult<Vec<Py<PyAny>>> {
+    if jobs == Some(0) {
+        return Err(PyValueError::new_err("jobs must be at least 1"));
+    }
+    let options = plan_options(solver, rate, acceleration_scale, time_limit)?;
+    let mut robots: HashMap<(PathBuf, Option<String>, Option<String>), PyResult<Py<PyRobot>>> =
+        HashMap::new();
+    let mut entries: Vec<PyResult<(Bound<'_, PyTask>, Py<PyRobot>)>> = Vec::new();
+    for item in tasks.try_iter()? {
+        let item = item?;
+        let task = match item.cast::<PyTask>() {
+            Ok(task) => Ok(task.clone()),
+            Err(_) => task_path(&item)
+                .and_then(|path| language::load(py, path))
+                .and_then(|task| Bound::new(py, task)),
+        };
+        let entry = task.and_then(|task| {
+            let robot = match &robot {
+                Some(robot) => robot.clone().unbind(),
+                None => {
+                    let t = &task.get().task;
+                    let key = (t.robot.clone(), t.robot_base.clone(), t.robot_tip.clone());
+                    let loaded = robots
+                        .entry(key)
+                        .or_insert_with(|| Py::new(py, PyRobot::of_task(py, t)?));
+                    match loaded {
+                        Ok(robot) => robot.clone_ref(py),
+                        Err(e) => return Err(e.clone_ref(py)),
+                    }
+                }
+            };
+            Ok((task, robot))
+        });
+        entries.push(entry);
+    }
+    let work: Vec<(&a2ml_core::Robot, Cow<'_, a2ml_core::language::Task>)> = entries
+        .iter()
+        .filter_map(|entry| entry.as_ref().ok())
+        .map(|(task, robot)| (&robot.get().robot, seeded(&task.get().task, seed)))
+        .collect();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs.unwrap_or(0))
+        .build()
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot start the planning threads: {e}")))?;
+    let planned: Vec<Result<Plan, solve::SolveError>> = py.detach(|| {
+        pool.install(|| {
+            work.par_iter().map(|(robot, task)| solve::plan(robot, task, &options)).collect()
+        })
+    });
+    let mut planned = planned.into_iter();
+    entries
+        .into_iter()
+        .map(|entry| {
+            let outcome = entry.and_then(|(task, robot)| {
+                // One result per task that reached the planner, in order.
+                let plan = planned.next().ok_or_else(|| {
+                    PyRuntimeError::new_err("plan_many lost a result (a bug in a2ml)")
+                })?;
+                let plan = plan.map_err(CoreError::from)?;
+                Ok(Py::new(py, PyPlan { plan, robot, task: task.unbind() })?.into_any())
+            });
+            Ok(outcome.unwrap_or_else(|e| e.into_value(py).into_any()))
+        })
+        .collect()
+}
+
+/// The task with `seed` as its seed, when given.
+fn seeded(
+    task: &a2ml_core::language::Task,
+    seed: Option<u64>,
+) -> Cow<'_, a2ml_core::language::Task> {
+    match seed {
+        Some(seed) => {
+            let mut seeded = task.clone();
+            seeded.settings.seed = seed;
+            Cow::Owned(seeded)
+        }
+        None => Cow::Borrowed(task),
+    }
+}
+
+/// The options `plan` and `plan_many` take.
+fn plan_options(
+    solver: Option<&str>,
+    rate: Option<Real>,
+    acceleration_scale: Option<Real>,
+    time_limit: Option<Real>,
+) -> PyResult<PlanOptions> {
+    Ok(PlanOptions {
+        solver: solver.map(solver_choice).transpose()?,
+        rate,
+        acceleration_scale,
+        time_limit,
+        ..PlanOptions::default()
+    })
 }
 
 /// `task_or_path` as a path, or the TypeError naming what it was.
@@ -208,6 +310,37 @@ impl PyPlan {
         py.detach(|| output::write_json(&path, robot, task, &self.plan))
             .map_err(CoreError::from)?;
         Ok(())
+    }
+
+    /// Writes one row per sample as Parquet, releasing the GIL: `task` (`task_id`, default
+    /// the task's name), `action`, `action_index`, `segment`, `t`, `q1`..`q7`, `qd1`..`qd7`,
+    /// `pw_x`..`pw_z`, `ow_w`..`ow_z`, `swivel`, `clearance` (s, m, rad; {b}).
+    #[pyo3(signature = (path, task_id=None))]
+    fn to_parquet(&self, py: Python<'_>, path: PathBuf, task_id: Option<&str>) -> PyResult<()> {
+        let (robot, task) = (&self.robot.get().robot, &self.task.get().task);
+        let id = task_id.unwrap_or(&self.plan.task);
+        py.detach(|| output::write_parquet(&path, robot, task, &self.plan, id))
+            .map_err(CoreError::from)?;
+        Ok(())
+    }
+
+    /// The table of `to_parquet` as a `pyarrow.Table` (pyarrow must be installed), which
+    /// `to_pandas()` and `polars.from_arrow` take as it is.
+    #[pyo3(signature = (task_id=None))]
+    fn to_arrow<'py>(&self, py: Python<'py>, task_id: Option<&str>) -> PyResult<Bound<'py, PyAny>> {
+        let parquet = py.import("pyarrow.parquet").map_err(|e| {
+            pyo3::exceptions::PyImportError::new_err(format!(
+                "Plan.to_arrow needs pyarrow (pip install pyarrow): {e}"
+            ))
+        })?;
+        let (robot, task) = (&self.robot.get().robot, &self.task.get().task);
+        let id = task_id.unwrap_or(&self.plan.task);
+        let bytes = py
+            .detach(|| output::parquet_bytes(robot, task, &self.plan, id))
+            .map_err(CoreError::from)?;
+        let buffer =
+            py.import("pyarrow")?.getattr("BufferReader")?.call1((PyBytes::new(py, &bytes),))?;
+        parquet.getattr("read_table")?.call1((buffer,))
     }
 
     /// The plan drawn as an SVG document: `kind` is one of `joints`, `velocities`,

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use a2ml_core::Robot;
+use a2ml_core::RobotOptions;
 use a2ml_core::language::SolverChoice;
 use a2ml_core::output as files;
 use a2ml_core::solve::compare::{ComparisonRecord, compare, records};
@@ -59,7 +59,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         }
     }
     let (task, source) = super::load_task(&args.file, &a2ml_core::language::Limits::default())?;
-    let robot = Robot::from_urdf_file(&task.robot)?;
+    let robot = task.load_robot(&RobotOptions::default())?;
     let options = PlanOptions::default();
     let attempts = compare(&robot, &task, &args.solvers, &options);
     let rows: Vec<ComparisonRecord> = attempts.iter().flat_map(|a| records(&robot, a)).collect();

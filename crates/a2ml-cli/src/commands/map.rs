@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 
-use a2ml_core::Robot;
+use a2ml_core::RobotOptions;
 use a2ml_core::decompose::DecomposeOptions;
 use a2ml_core::output::{swivel_map_svg, write_text};
 use a2ml_core::solve::SolveError;
@@ -58,7 +58,7 @@ pub struct MapArgs {
 /// [`CliError::Planning`] when the map cannot be built.
 pub fn run(args: &MapArgs) -> Result<(), CliError> {
     let (task, _) = super::load_task(&args.file, &a2ml_core::language::Limits::default())?;
-    let robot = Robot::from_urdf_file(&task.robot)?;
+    let robot = task.load_robot(&RobotOptions::default())?;
     if args.segment == 0 {
         return Err(CliError::Input("--segment counts from 1".to_owned()));
     }

@@ -36,25 +36,35 @@ Examples:
   a2ml plan examples/construct_path_line.a2ml
   a2ml plan task.a2ml -o out.mcap --csv out.csv --json out.json
   a2ml plan task.a2ml --solver qp --rate 250 --seed 7
+  a2ml plan tasks/ -o 'out/{stem}.mcap' --parquet 'out/{stem}.parquet' --jobs 2
+  a2ml plan 'sweep/*.a2ml' --csv 'out/{stem}.csv'
 
-Without -o, --csv or --json the MCAP file goes to <FILE stem>.mcap in the
-current folder. Outputs replace only regular files, never a task or robot
-file of the run: a folder, device, FIFO or symbolic link is refused. Every
-output is written to a temporary file beside it, and all are renamed once
-every one is complete, so a failed or interrupted run (SIGINT, SIGTERM,
-SIGHUP: exit 130, 143, 129) leaves the old files as they were and no
+Without -o, --csv, --json or --parquet the MCAP file goes to <FILE stem>.mcap
+in the current folder. An output path may hold {stem}, the task file's name
+without its extension: with several tasks each output must, so that every task
+writes files of its own. Outputs replace only regular files, never a task or
+robot file of the run: a folder, device, FIFO or symbolic link is refused.
+Every output is written to a temporary file beside it, and all of a task's are
+renamed once every one is complete, so a failed or interrupted run (SIGINT,
+SIGTERM, SIGHUP: exit 130, 143, 129) leaves the old files as they were and no
 temporary file.
+
+Several tasks (several FILEs, a folder: every *.a2ml in it, or a quoted
+pattern) are planned in parallel, --jobs at a time, each exactly as it would
+be alone (its own seed); one line per task is printed in the order given, then
+the count. A task that fails is reported with its file and the others go on.
 
 Exit codes: 0 success, 1 a file cannot be read or written, 2 the task, an
 option or an output path is not valid or the task cannot be decomposed, 3 a goal is missed
 beyond tolerance (the files are written all the same), 4 the solver failed
-on a segment (nothing is written).")]
+on a segment (nothing is written). With several tasks, the worst of theirs:
+1, then 2, then 4, then 3.")]
 pub struct PlanArgs {
-    /// The task file.
-    #[arg(value_name = "FILE")]
-    pub file: PathBuf,
+    /// The task files, folders of task files or quoted patterns (`tasks/*.a2ml`).
+    #[arg(value_name = "FILE", required = true)]
+    pub files: Vec<PathBuf>,
     /// Write the plan as MCAP, for Foxglove [default: <FILE stem>.mcap, when
-    /// neither --csv nor --json is given].
+    /// no other output is given].
     #[arg(short = 'o', long = "output", value_name = "OUT.mcap")]
     pub output: Option<PathBuf>,
     /// Write the joint trajectory as CSV: t, then <joint>_pos and <joint>_vel.
@@ -63,6 +73,13 @@ pub struct PlanArgs {
     /// Write the plan as JSON: trajectory, segment reports, warnings.
     #[arg(long, value_name = "OUT.json")]
     pub json: Option<PathBuf>,
+    /// Write one row per sample as Parquet: task, action, segment, t, q, qd, wrist state,
+    /// clearance (the same columns for every robot, so a batch loads as one table).
+    #[arg(long, value_name = "OUT.parquet")]
+    pub parquet: Option<PathBuf>,
+    /// How many tasks are planned at once [default: one per core].
+    #[arg(short = 'j', long, value_name = "N")]
+    pub jobs: Option<std::num::NonZeroUsize>,
     /// Solver for every segment, overriding the task's choices.
     #[arg(long, value_name = "SOLVER", value_parser = solver_parser())]
     pub solver: Option<SolverChoice>,
@@ -127,13 +144,14 @@ fn parse_rate(text: &str) -> Result<Real, String> {
 
 /// The kinds of file `a2ml plan` writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Format {
+pub(crate) enum Format {
     Mcap,
     Csv,
     Json,
+    Parquet,
 }
 
-/// Runs `a2ml plan`.
+/// Runs `a2ml plan`: one task file as below, or many through [`crate::batch`].
 ///
 /// # Errors
 /// [`CliError::Io`] when the task or robot cannot be read or an output not
@@ -142,7 +160,141 @@ enum Format {
 /// does not exist yet; [`CliError::Planning`] when a segment's solve fails;
 /// [`CliError::Missed`] when the plan, written all the same, misses a goal.
 pub fn run(args: &PlanArgs, temporaries: &Temporaries) -> Result<(), CliError> {
-    let outputs = outputs(args);
+    let files = crate::batch::task_files(&args.files)?;
+    match (args.files.as_slice(), files.as_slice()) {
+        ([given], [file]) if given == file && !given.is_dir() => run_one(args, file, temporaries),
+        _ => crate::batch::run(args, &files, temporaries),
+    }
+}
+
+/// Plans one task file with its summary table and progress bar.
+fn run_one(args: &PlanArgs, file: &Path, temporaries: &Temporaries) -> Result<(), CliError> {
+    let outputs = outputs(args, file);
+    check_outputs(&outputs)?;
+    let planning = Planning::load(args, file, &outputs, &[])?;
+
+    let started = Instant::now();
+    let mut bar = ProgressBar::new(started);
+    let result = planning.plan(&mut |p| bar.update(p));
+    bar.clear();
+    let plan = result?;
+    let planning_time = started.elapsed();
+
+    for warning in &plan.warnings {
+        output::warn(warning);
+    }
+    let tolerance = planning.options.qp.tolerance;
+    output::print(&summary(file, &planning.robot, &plan, &tolerance, planning_time))?;
+    planning.write(temporaries, &outputs, &plan)?;
+    for (_, path) in &outputs {
+        output::print(&format!("wrote  {}\n", path.display()))?;
+    }
+    verdict(&plan)
+}
+
+/// One task, read and ready to plan: what `a2ml plan` does for each task file.
+pub(crate) struct Planning<'a> {
+    /// The task file.
+    pub file: &'a Path,
+    /// The validated task, `--seed` applied.
+    pub task: Task,
+    /// The task file's text (MCAP attaches it).
+    pub source: String,
+    /// The task's robot, with its base and tip.
+    pub robot: Robot,
+    /// The command line's planning options.
+    pub options: PlanOptions,
+}
+
+impl<'a> Planning<'a> {
+    /// Reads the task and its robot; refuses an output that is the task, its robot or one of
+    /// `inputs` (the other tasks of a batch).
+    ///
+    /// # Errors
+    /// As [`run`], before planning.
+    pub fn load(
+        args: &PlanArgs,
+        file: &'a Path,
+        outputs: &[(Format, PathBuf)],
+        inputs: &[PathBuf],
+    ) -> Result<Self, CliError> {
+        let limits = args.limits.limits();
+        let (mut task, source) = super::load_task(file, &limits)?;
+        if let Some(seed) = args.seed {
+            task.settings.seed = seed;
+        }
+        for (_, path) in outputs {
+            let mut read: Vec<&Path> = vec![file, &task.robot];
+            read.extend(inputs.iter().map(PathBuf::as_path));
+            output::check_not_an_input(path, &read)?;
+        }
+        let robot = task.load_robot(&args.arm.options(None, None)?)?;
+        let options = PlanOptions {
+            solver: args.solver,
+            rate: args.rate,
+            acceleration_scale: args.acceleration_scale,
+            time_limit: args.time_limit,
+            limits,
+            allow_close_start: args.allow_close_start,
+            ..PlanOptions::default()
+        };
+        Ok(Self { file, task, source, robot, options })
+    }
+
+    /// Plans the task, reporting progress to `progress`.
+    ///
+    /// # Errors
+    /// As [`solve_error`]; a start too close to an obstacle is shown in the task's text first.
+    pub fn plan(&self, progress: &mut dyn FnMut(&Progress)) -> Result<Plan, CliError> {
+        solve::plan_with_progress(&self.robot, &self.task, &self.options, progress).map_err(|e| {
+            if let SolveError::Check(CheckError::StartTooClose { action_index, order, .. }) = &e {
+                report_start(self.file, &self.source, *action_index, *order, &e.to_string());
+            }
+            solve_error(self.file, e)
+        })
+    }
+
+    /// Writes every output: each to its temporary file first, then all renamed, so a run that
+    /// fails on one output leaves the others as they were.
+    ///
+    /// # Errors
+    /// [`CliError::Io`] (or [`CliError::Input`] for a path that is not a regular file).
+    pub fn write(
+        &self,
+        temporaries: &Temporaries,
+        outputs: &[(Format, PathBuf)],
+        plan: &Plan,
+    ) -> Result<(), CliError> {
+        let mut staged = Vec::with_capacity(outputs.len());
+        for (format, path) in outputs {
+            let mut file = temporaries.stage(path).map_err(output_error)?;
+            self.fill(*format, &mut file, plan).map_err(output_error)?;
+            staged.push(file);
+        }
+        temporaries.commit_all(staged).map_err(output_error)
+    }
+
+    fn fill(&self, format: Format, staged: &mut Staged, plan: &Plan) -> Result<(), OutputError> {
+        let (robot, task) = (&self.robot, &self.task);
+        match format {
+            Format::Mcap => files::fill_mcap(staged, robot, task, &self.source, plan),
+            Format::Csv => files::fill_csv(staged, robot, plan),
+            Format::Json => files::fill_json(staged, robot, task, plan),
+            Format::Parquet => files::fill_parquet(staged, robot, task, plan, &task_id(self.file)),
+        }
+    }
+}
+
+/// A task's name in a batch's tables: its file's stem.
+fn task_id(file: &Path) -> String {
+    file.file_stem().map_or_else(|| "plan".to_owned(), |s| s.to_string_lossy().into_owned())
+}
+
+/// Refuses, before planning, an output that cannot be written or is given twice.
+///
+/// # Errors
+/// As [`output::check_output`]; [`CliError::Input`] for a path given twice.
+pub(crate) fn check_outputs(outputs: &[(Format, PathBuf)]) -> Result<(), CliError> {
     for (k, (_, path)) in outputs.iter().enumerate() {
         output::check_output(path)?;
         if outputs[..k].iter().any(|(_, earlier)| earlier == path) {
@@ -152,56 +304,15 @@ pub fn run(args: &PlanArgs, temporaries: &Temporaries) -> Result<(), CliError> {
             )));
         }
     }
-    let limits = args.limits.limits();
-    let (mut task, source) = super::load_task(&args.file, &limits)?;
-    if let Some(seed) = args.seed {
-        task.settings.seed = seed;
-    }
-    for (_, path) in &outputs {
-        output::check_not_an_input(path, &[&args.file, &task.robot])?;
-    }
-    let robot_options = args.arm.options(task.robot_base.as_deref(), task.robot_tip.as_deref())?;
-    let robot = Robot::from_urdf_file_with(&task.robot, &robot_options)?;
-    let options = PlanOptions {
-        solver: args.solver,
-        rate: args.rate,
-        acceleration_scale: args.acceleration_scale,
-        time_limit: args.time_limit,
-        limits,
-        allow_close_start: args.allow_close_start,
-        ..PlanOptions::default()
-    };
+    Ok(())
+}
 
-    let started = Instant::now();
-    let mut bar = ProgressBar::new(started);
-    let result = solve::plan_with_progress(&robot, &task, &options, &mut |p| bar.update(p));
-    bar.clear();
-    let plan = result.map_err(|e| {
-        if let SolveError::Check(CheckError::StartTooClose { action_index, order, .. }) = &e {
-            report_start(&args.file, &source, *action_index, *order, &e.to_string());
-        }
-        solve_error(&args.file, e)
-    })?;
-    let planning_time = started.elapsed();
-
-    for warning in &plan.warnings {
-        output::warn(warning);
-    }
-    let tolerance = options.qp.tolerance;
-    output::print(&summary(&args.file, &robot, &plan, &tolerance, planning_time))?;
-    // Every output to its temporary file first, then all renamed: a run that fails on one
-    // output leaves the others as they were.
-    let mut staged = Vec::with_capacity(outputs.len());
-    for (format, path) in &outputs {
-        let mut file = temporaries.stage(path).map_err(output_error)?;
-        write(*format, &mut file, &robot, &task, &source, &plan).map_err(output_error)?;
-        staged.push(file);
-    }
-    temporaries.commit_all(staged).map_err(output_error)?;
-    for (_, path) in &outputs {
-        output::print(&format!("wrote  {}\n", path.display()))?;
-    }
-
+/// A written plan that misses a goal, leaves a hard path or exceeds a limit is
+/// [`CliError::Missed`], naming how many segments did.
+///
+/// # Errors
+/// [`CliError::Missed`].
+pub(crate) fn verdict(plan: &Plan) -> Result<(), CliError> {
     let missed = plan.segments.iter().filter(|s| !s.reached).count();
     let off_path = plan.segments.iter().filter(|s| !s.path_kept).count();
     let over = plan.segments.iter().filter(|s| !s.limits_kept).count();
@@ -227,18 +338,30 @@ pub fn run(args: &PlanArgs, temporaries: &Temporaries) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The files to write: those asked for, else `<stem>.mcap` in the current folder.
-fn outputs(args: &PlanArgs) -> Vec<(Format, PathBuf)> {
-    let asked =
-        [(Format::Mcap, &args.output), (Format::Csv, &args.csv), (Format::Json, &args.json)];
+/// The files to write for the task `file`: those asked for, `{stem}` replaced by the file's
+/// stem, else `<stem>.mcap` in the current folder.
+pub(crate) fn outputs(args: &PlanArgs, file: &Path) -> Vec<(Format, PathBuf)> {
+    let asked = [
+        (Format::Mcap, &args.output),
+        (Format::Csv, &args.csv),
+        (Format::Json, &args.json),
+        (Format::Parquet, &args.parquet),
+    ];
+    let stem = task_id(file);
+    let named = |pattern: &PathBuf| {
+        let text = pattern.to_string_lossy();
+        if text.contains(STEM) { PathBuf::from(text.replace(STEM, &stem)) } else { pattern.clone() }
+    };
     let mut outputs: Vec<(Format, PathBuf)> =
-        asked.iter().filter_map(|(f, p)| p.as_ref().map(|p| (*f, p.clone()))).collect();
+        asked.iter().filter_map(|(f, p)| p.as_ref().map(|p| (*f, named(p)))).collect();
     if outputs.is_empty() {
-        let stem = args.file.file_stem().map_or_else(|| "plan".into(), ToOwned::to_owned);
-        outputs.push((Format::Mcap, PathBuf::from(stem).with_extension("mcap")));
+        outputs.push((Format::Mcap, PathBuf::from(&stem).with_extension("mcap")));
     }
     outputs
 }
+
+/// The placeholder of an output path for the task file's stem.
+pub(crate) const STEM: &str = "{stem}";
 
 /// Fails early, before a long plan, when an output's folder does not exist.
 ///
@@ -250,21 +373,6 @@ pub(crate) fn check_folder(path: &Path) -> Result<(), CliError> {
             format!("cannot write {}: there is no folder {}", path.display(), folder.display()),
         )),
         _ => Ok(()),
-    }
-}
-
-fn write(
-    format: Format,
-    staged: &mut Staged,
-    robot: &Robot,
-    task: &Task,
-    source: &str,
-    plan: &Plan,
-) -> Result<(), OutputError> {
-    match format {
-        Format::Mcap => files::fill_mcap(staged, robot, task, source, plan),
-        Format::Csv => files::fill_csv(staged, robot, plan),
-        Format::Json => files::fill_json(staged, robot, task, plan),
     }
 }
 
@@ -531,10 +639,12 @@ mod tests {
     #[test]
     fn default_output_is_the_stem_in_the_current_folder() {
         let args = PlanArgs {
-            file: PathBuf::from("examples/lines.a2ml"),
+            files: vec![PathBuf::from("examples/lines.a2ml")],
             output: None,
             csv: None,
             json: None,
+            parquet: None,
+            jobs: None,
             solver: None,
             rate: None,
             seed: None,
@@ -549,8 +659,17 @@ mod tests {
                 max_input_bytes: 1,
             },
         };
-        assert_eq!(outputs(&args), vec![(Format::Mcap, PathBuf::from("lines.mcap"))]);
+        let file = Path::new("examples/lines.a2ml");
+        assert_eq!(outputs(&args, file), vec![(Format::Mcap, PathBuf::from("lines.mcap"))]);
         let args = PlanArgs { csv: Some(PathBuf::from("x.csv")), ..args };
-        assert_eq!(outputs(&args), vec![(Format::Csv, PathBuf::from("x.csv"))]);
+        assert_eq!(outputs(&args, file), vec![(Format::Csv, PathBuf::from("x.csv"))]);
+        let args = PlanArgs { parquet: Some(PathBuf::from("out/{stem}-plan.parquet")), ..args };
+        assert_eq!(
+            outputs(&args, file),
+            vec![
+                (Format::Csv, PathBuf::from("x.csv")),
+                (Format::Parquet, PathBuf::from("out/lines-plan.parquet"))
+            ]
+        );
     }
 }

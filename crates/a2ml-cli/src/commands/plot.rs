@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 
-use a2ml_core::Robot;
+use a2ml_core::{Robot, RobotOptions};
 use a2ml_core::language::Task;
 use a2ml_core::output::plot::{PlotKind, write_plot};
 use a2ml_core::solve::{self, Plan, PlanOptions};
@@ -74,7 +74,7 @@ pub fn plan_file(file: &Path, seed: Option<u64>) -> Result<Planned, CliError> {
     if let Some(seed) = seed {
         task.settings.seed = seed;
     }
-    let robot = Robot::from_urdf_file(&task.robot)?;
+    let robot = task.load_robot(&RobotOptions::default())?;
     let plan = solve::plan(&robot, &task, &PlanOptions::default())
         .map_err(|e| super::plan::solve_error(file, e))?;
     for warning in &plan.warnings {

@@ -2,6 +2,7 @@
 //! files written and exit codes.
 
 mod analyze;
+mod batch;
 mod compare;
 mod bounds;
 mod examples;

@@ -3,12 +3,14 @@
 //!
 //! Entry points: [`parse`] (text), [`load`] (a file), [`parse_ast`] (the
 //! syntax tree alone, comments included), [`format()`] (a syntax tree back
-//! to canonical text, comments kept). Units become SI at validation; every
+//! to canonical text, comments kept), [`with_goal`] (a task's text with new
+//! goal values). Units become SI at validation; every
 //! syntax node keeps the byte span of its text.
 
 pub mod ast;
 mod bounds;
 mod diagnostic;
+mod edit;
 mod format;
 mod syntax;
 mod task;
@@ -18,6 +20,7 @@ use std::path::Path;
 
 pub use bounds::{Limits, MAX_ANGLE, MAX_LENGTH, ReadError, read_source, samples};
 pub use diagnostic::{Diagnostic, Diagnostics};
+pub use edit::{EditError, with_goal};
 pub use format::format;
 pub use task::*;
 

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use super::ast::Span;
 use crate::math::{JointVector, Real, Rotation3, Vector3};
+use crate::robot::{Robot, RobotError, RobotOptions};
 
 /// The two representation spaces (docs/design.md §3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
@@ -474,6 +475,21 @@ impl Task {
     pub fn action_scene(&self, action: usize) -> Vec<Obstacle> {
         let contact = &self.actions[action].contact;
         self.scene.iter().filter(|o| !contact.contains(&o.name)).cloned().collect()
+    }
+
+    /// Loads the task's robot: its URDF (resolved relative to the task file) with the `robot`
+    /// line's `base` and `tip`, unless `options` names its own.
+    ///
+    /// # Errors
+    /// As [`Robot::from_urdf_file`]: a missing or unreadable file, no such link, or no unique
+    /// 7-joint chain between them.
+    pub fn load_robot(&self, options: &RobotOptions) -> Result<Robot, RobotError> {
+        let options = RobotOptions {
+            base: options.base.clone().or_else(|| self.robot_base.clone()),
+            tip: options.tip.clone().or_else(|| self.robot_tip.clone()),
+            ..options.clone()
+        };
+        Robot::from_urdf_file_with(&self.robot, &options)
     }
 
     /// The task with every position (goals, start state, obstacles) in {b},

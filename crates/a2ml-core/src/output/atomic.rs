@@ -19,6 +19,8 @@ pub(super) enum Failure {
     Mcap(String),
     /// JSON encoding failed.
     Json(String),
+    /// The Parquet writer failed.
+    Parquet(String),
 }
 
 impl From<io::Error> for Failure {
@@ -38,12 +40,13 @@ impl From<serde_json::Error> for Failure {
 
 impl Failure {
     /// The public error, naming the target path.
-    fn at(self, path: &Path) -> OutputError {
+    pub(super) fn at(self, path: &Path) -> OutputError {
         let path = path.display().to_string();
         match self {
             Self::Io(e) => OutputError::Io { path, message: e.to_string() },
             Self::Mcap(message) => OutputError::Mcap { path, message },
             Self::Json(message) => OutputError::Json { path, message },
+            Self::Parquet(message) => OutputError::Parquet { path, message },
         }
     }
 }

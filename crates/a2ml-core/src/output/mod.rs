@@ -1,8 +1,8 @@
 //! Writing a [`Plan`] to files (docs/design.md §6): an MCAP recording for Foxglove, a CSV table
-//! of the joint trajectory, the plan as JSON, SVG pictures ([`plot`]) and an HTML report
+//! of the joint trajectory, the plan as JSON, a Parquet table of the samples, SVG pictures ([`plot`]) and an HTML report
 //! ([`report`]).
 //!
-//! Entry points: [`write_mcap`], [`write_csv`], [`write_json`], [`plot::write_plot`],
+//! Entry points: [`write_mcap`], [`write_csv`], [`write_json`], [`write_parquet`], [`plot::write_plot`],
 //! [`report::write_report`]. Every writer goes through a
 //! temporary file beside the target, renamed on success and removed on failure, so a failed
 //! run never leaves a partial file; several outputs can be [`Staged`] first and committed
@@ -14,8 +14,9 @@ mod csv;
 mod json;
 mod mcap_file;
 mod messages;
-mod read;
+mod parquet;
 pub mod plot;
+mod read;
 pub mod report;
 mod schemas;
 mod swivel_map;
@@ -93,6 +94,14 @@ pub enum OutputError {
         /// The path as given.
         path: String,
         /// The plotting backend's message.
+        message: String,
+    },
+    /// The Parquet writer failed to encode the table.
+    #[error("cannot encode the Parquet file {path}: {message}")]
+    Parquet {
+        /// The path as given.
+        path: String,
+        /// The writer's message.
         message: String,
     },
     /// A value could not be encoded as JSON.
@@ -174,6 +183,50 @@ pub fn write_csv(path: &Path, robot: &Robot, plan: &Plan) -> Result<(), OutputEr
 /// [`OutputError`] when the file cannot be written; the target is then left untouched.
 pub fn write_json(path: &Path, robot: &Robot, task: &Task, plan: &Plan) -> Result<(), OutputError> {
     atomic::write_atomically(path, |out| json::write(out, robot, task, plan))
+}
+
+/// Writes the plan as a Parquet table, one row per sample: `task` (`task_id`), `action`,
+/// `action_index`, `segment`, `t`, `q1`..`q7`, `qd1`..`qd7`, the wrist state `pw_x`..`pw_z`,
+/// `ow_w`..`ow_z`, `swivel`, and `clearance` (s, m, rad; {b}); the same columns for every
+/// robot, so a batch's files load as one table.
+///
+/// # Errors
+/// [`OutputError`] when the file cannot be written; the target is then left untouched.
+pub fn write_parquet(
+    path: &Path,
+    robot: &Robot,
+    task: &Task,
+    plan: &Plan,
+    task_id: &str,
+) -> Result<(), OutputError> {
+    atomic::write_atomically(path, |out| parquet::write(out, robot, task, plan, task_id))
+}
+
+/// [`write_parquet`] into a staged temporary file.
+///
+/// # Errors
+/// As [`write_parquet`].
+pub fn fill_parquet(
+    staged: &mut Staged,
+    robot: &Robot,
+    task: &Task,
+    plan: &Plan,
+    task_id: &str,
+) -> Result<(), OutputError> {
+    staged.fill(|out| parquet::write(out, robot, task, plan, task_id))
+}
+
+/// The Parquet table of [`write_parquet`] as the bytes of a file, in memory.
+///
+/// # Errors
+/// [`OutputError::Parquet`] when the table cannot be encoded.
+pub fn parquet_bytes(
+    robot: &Robot,
+    task: &Task,
+    plan: &Plan,
+    task_id: &str,
+) -> Result<Vec<u8>, OutputError> {
+    parquet::to_bytes(robot, task, plan, task_id).map_err(|e| e.at(Path::new("<memory>")))
 }
 
 /// Writes `text` to `path` through a temporary file (figures, reports).

@@ -15,6 +15,8 @@ shoulder centre. Arrays are float64 numpy arrays.
 >>> plan = a2ml.plan("push.a2ml")  # doctest: +SKIP
 >>> plan.t.shape, plan.q.shape, plan.reached  # doctest: +SKIP
 >>> plan.write_mcap("push.mcap")  # doctest: +SKIP
+>>> tasks = [task.with_goal("push_a", pw=[0.3, y, -0.2]) for y in (-0.1, 0.0)]  # doctest: +SKIP
+>>> plans = a2ml.plan_many(tasks)  # doctest: +SKIP
 >>> m = a2ml.swivel_map("push.a2ml", action="push_a")  # doctest: +SKIP
 >>> m["labels"].shape, m["profile"]["q"].shape  # doctest: +SKIP
 
@@ -47,6 +49,7 @@ from a2ml._a2ml import (
     load,
     parse,
     plan,
+    plan_many,
     swivel_map,
 )
 from a2ml._types import (
@@ -88,5 +91,6 @@ __all__ = [
     "load",
     "parse",
     "plan",
+    "plan_many",
     "swivel_map",
 ]

@@ -19,6 +19,7 @@ segment, and the MCAP, CSV and JSON writers (docs/design.md §6).
 """
 
 import os
+from collections.abc import Iterable
 from typing import Any, ClassVar, Literal, final
 
 import numpy as np
@@ -36,6 +37,7 @@ __all__ = [
     "swivel_map",
     "decompose",
     "plan",
+    "plan_many",
     "Plan",
     "SegmentReport",
     "A2mlError",
@@ -369,6 +371,33 @@ class Task:
         """``name``, ``robot``, ``start``, ``scene``, ``settings``, ``init``,
         ``goal`` and ``actions`` in one dict."""
 
+    def with_goal(
+        self,
+        action: str,
+        *,
+        pw: ArrayLike | None = ...,
+        ow: ArrayLike | None = ...,
+        swivel: float | None = ...,
+        os: ArrayLike | None = ...,
+        elbow: float | None = ...,
+    ) -> Task:
+        """A new task: this one with the goal values of ``action`` replaced
+        (``pw``: a (3,) position in m; ``ow``, ``os``: (3, 3) rotations;
+        ``swivel``, ``elbow``: angles in rad), in the task's frame. Only a
+        goal the action states can change, in its primary or secondary term.
+        The new task is this task's text with those values, printed in
+        canonical form (comments kept) and validated: it pickles, and is
+        attached to outputs, as any parsed task. For sweeps without string
+        templating: ``[task.with_goal("reach", pw=p) for p in grid]``.
+
+        Raises:
+            TypeError: a keyword that is not a variable.
+            ValueError: no such action, no goal on a variable, a value of
+                the wrong shape.
+            ParseError: the new values make the task invalid (out of reach
+                of the workspace bound, say).
+        """
+
 def parse(text: str, path: str | os.PathLike[str] | None = None) -> Task:
     """Parse and validate an A2ML task.
 
@@ -646,6 +675,29 @@ class Plan:
             OSError: the file cannot be written.
         """
 
+    def to_parquet(self, path: str | os.PathLike[str], task_id: str | None = None) -> None:
+        """Write one row per sample as a Parquet table (zstd): ``task``
+        (``task_id``, default the task's name), ``action``, ``action_index``,
+        ``segment`` (within its action), ``t``, ``q1``..``q7``,
+        ``qd1``..``qd7``, the wrist state ``pw_x``..``pw_z``,
+        ``ow_w``..``ow_z`` (unit quaternion) and ``swivel`` (null where
+        singular), and ``clearance`` (m, null without obstacles); the same
+        columns for every robot, so the files of a batch load as one table
+        (``pandas.read_parquet(folder)``). Atomic as :meth:`write_mcap`;
+        releases the GIL.
+
+        Raises:
+            OSError: the file cannot be written.
+        """
+
+    def to_arrow(self, task_id: str | None = None) -> Any:
+        """The table of :meth:`to_parquet` as a ``pyarrow.Table``, for
+        ``.to_pandas()`` or ``polars.from_arrow``.
+
+        Raises:
+            ImportError: pyarrow is not installed.
+        """
+
     def metrics(self) -> dict[str, Any]:
         """The human-likeness measures of the plan, as
         :func:`a2ml.metrics.analyze` returns them: ``frames`` (float64 arrays
@@ -735,6 +787,29 @@ def plan(
         UrdfError: the task's robot file cannot be loaded as a 7-DoF arm.
         DecomposeError: the task cannot be decomposed.
         PlanError: the solver is not available yet, or a segment cannot be solved.
+    """
+
+def plan_many(
+    tasks: Iterable[Task | str | os.PathLike[str]],
+    robot: Robot | None = None,
+    jobs: int | None = None,
+    solver: Literal["auto", "qp", "rrt", "map", "gpm", "clik", "pmp", "hamp"] | None = None,
+    rate: float | None = None,
+    seed: int | None = None,
+    acceleration_scale: float | None = None,
+    time_limit: float | None = None,
+) -> list[Plan | Exception]:
+    """Plan many tasks (Tasks or paths) at once on ``jobs`` threads (default:
+    one per core), without the GIL: one entry per task in input order, the
+    :class:`Plan` that :func:`plan` would return or the exception it would
+    raise (a :class:`ParseError`, ``OSError``, :class:`UrdfError`,
+    :class:`PlanError`, ...), so one failure does not stop the others. Each
+    plan equals :func:`plan` of its task with the same options. ``robot``
+    defaults to each task's own, loaded once per file, base and tip.
+
+    Raises:
+        ValueError: ``jobs`` is 0, or ``solver`` is not a solver's name.
+        TypeError: ``tasks`` is not iterable.
     """
 
 def compare(
