@@ -23,10 +23,14 @@ pub mod monitor;
 pub(crate) mod plan;
 pub mod pmp;
 pub mod qp;
+mod references;
 mod report;
 pub mod rrt;
 
 pub use checks::CheckError;
 pub use monitor::Monitor;
 pub use plan::{PlanOptions, Progress, SolveError, plan, plan_with_progress};
-pub use report::{Fallback, Plan, QpStats, SegmentReport, Tolerance, VariableError};
+pub use report::{
+    Fallback, Plan, QpStats, ReferenceSample, ReferenceState, SegmentReport, Tolerance,
+    VariableError,
+};
