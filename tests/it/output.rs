@@ -8,12 +8,14 @@ use std::path::{Path, PathBuf};
 
 use a2ml::Robot;
 use a2ml::decompose::{ActionType, SegmentPattern};
-use a2ml::kinematics::{arm_pose, link_poses};
+use a2ml::kinematics::{arm_pose, cpsa_state, hat_state, link_poses};
 use a2ml::language::{Shape, SolverChoice, Space, Task, Variable, parse};
-use a2ml::math::{JointVector, Real, Vector3};
+use a2ml::math::{JointVector, Real, UnitQuaternion, Vector3};
 use a2ml::output::{OutputError, topics, write_csv, write_json, write_mcap};
-use a2ml::solve::{Fallback, Plan, QpStats, SegmentReport, VariableError};
-use a2ml::trajectory::{Clearance, Trajectory};
+use a2ml::solve::{
+    Fallback, Plan, QpStats, ReferenceSample, ReferenceState, SegmentReport, VariableError,
+};
+use a2ml::trajectory::{CapsuleDistances, Clearance, Trajectory};
 use serde_json::Value;
 
 use crate::common::{self, load};
@@ -98,6 +100,16 @@ fn plan(robot: &Robot) -> Plan {
         .zip(trajectory.positions())
         .map(|(&t, q)| (t, arm_pose(robot, q).wrist + Vector3::new(0.0, 0.0, 0.01)))
         .collect();
+    let references = trajectory
+        .times()
+        .iter()
+        .zip(trajectory.positions())
+        .map(|(&t, q)| ReferenceSample {
+            segment: usize::from(t >= 0.201),
+            state: reference_state(robot, q),
+        })
+        .collect();
+    let ends = [trajectory.positions()[62], trajectory.positions()[SAMPLES - 1]];
     Plan {
         task: "avoid".into(),
         joint_names: robot.joint_names().iter().map(|s| s.to_string()).collect(),
@@ -107,6 +119,31 @@ fn plan(robot: &Robot) -> Plan {
         wrist_reference,
         safety_distance: 0.02,
         warnings: vec!["back, segment 1: a warning".into()],
+        references,
+        reference_ends: ends.iter().map(|q| reference_state(robot, q)).collect(),
+        distances: vec![CapsuleDistances {
+            capsule: robot.capsules[1].name.clone(),
+            capsule_index: 1,
+            obstacle: "table".into(),
+            distance: (0..SAMPLES)
+                .map(|k| (k % 10 != 3).then_some(0.1 + k as Real * 1e-3))
+                .collect(),
+        }],
+    }
+}
+
+/// The reference state of configuration `q`, shifted 1 cm up (so that it differs from the
+/// planned state).
+fn reference_state(robot: &Robot, q: &JointVector) -> ReferenceState {
+    let pose = arm_pose(robot, q);
+    let cpsa = cpsa_state(robot, &pose).ok();
+    let hat = hat_state(&pose).ok();
+    ReferenceState {
+        pw: cpsa.map(|s| s.pw + Vector3::new(0.0, 0.0, 0.01)),
+        ow: cpsa.map(|s| UnitQuaternion::from_rotation_matrix(&s.ow)),
+        swivel: cpsa.map(|s| s.swivel + 0.1),
+        shoulder_frame: hat.map(|s| UnitQuaternion::from_rotation_matrix(&s.shoulder_frame)),
+        elbow_angle: hat.map(|s| s.elbow_angle),
     }
 }
 
@@ -224,6 +261,8 @@ fn every_channel_has_its_schema_and_encoding() {
         (topics::ARM_CAPSULES, "foxglove.SceneUpdate"),
         (topics::WRIST_PATH, "foxglove.SceneUpdate"),
         (topics::STATE, "a2ml.State"),
+        (topics::REFERENCE, "a2ml.Reference"),
+        (topics::DISTANCES, "a2ml.Distances"),
         (topics::SEGMENTS, "a2ml.Segment"),
         (topics::ROBOT_DESCRIPTION, "std_msgs/String"),
     ];
@@ -247,7 +286,9 @@ fn message_counts_follow_the_samples() {
     let count = |topic: &str| recording.messages.get(topic).map_or(0, Vec::len);
     let n = plan.trajectory.len();
     assert_eq!(n, SAMPLES);
-    for topic in [topics::JOINT_STATES, topics::TF, topics::STATE] {
+    for topic in
+        [topics::JOINT_STATES, topics::TF, topics::STATE, topics::REFERENCE, topics::DISTANCES]
+    {
         assert_eq!(count(topic), n, "{topic}");
     }
     for topic in
@@ -530,15 +571,109 @@ fn each_segment_is_recorded_at_its_start() {
     assert_eq!(records[1]["reached"], true);
 }
 
-/// Parses the CSV written for `plan`: header and rows of numbers.
-fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<Real>>) {
+#[test]
+fn the_references_and_distances_are_recorded_per_sample() {
+    let (_, _, _, plan, recording) = written("references", "construct_scene.a2ml");
+    for (k, (_, _, m)) in recording.messages[topics::REFERENCE].iter().enumerate() {
+        let expected = &plan.references[k];
+        assert_eq!(m["segment"].as_u64(), Some(expected.segment as u64));
+        let pw = expected.state.pw.expect("Pw");
+        assert_eq!(xyz(&m["pw"]), pw, "Pw at sample {k}");
+        assert_eq!(m["swivel"].as_f64(), expected.state.swivel);
+        assert_eq!(m["elbow_angle"].as_f64(), expected.state.elbow_angle);
+        let o = &m["shoulder_frame"];
+        let [x, y, z, w] = ["x", "y", "z", "w"].map(|c| o[c].as_f64().expect("component"));
+        let os = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z));
+        assert!(os.angle_to(&expected.state.shoulder_frame.expect("Os")) < 1e-12);
+    }
+    for (k, (_, _, m)) in recording.messages[topics::DISTANCES].iter().enumerate() {
+        let pairs = m["distances"].as_array().expect("pairs");
+        assert_eq!(pairs.len(), 1);
+        assert_eq!(pairs[0]["obstacle"], "table");
+        assert_eq!(pairs[0]["capsule_index"], 1);
+        assert_eq!(pairs[0]["distance"].as_f64(), plan.distances[0].distance[k], "sample {k}");
+    }
+    let records = &recording.messages[topics::SEGMENTS];
+    let end = &records[1].2["reference_end"];
+    assert_eq!(end["swivel"].as_f64(), plan.reference_ends[1].swivel);
+    assert_eq!(xyz(&end["pw"]), plan.reference_ends[1].pw.expect("Pw"));
+}
+
+#[test]
+fn a_recording_reads_back_as_the_plan() {
+    let (robot, task, source, plan, recording) = written("read_back", "construct_scene.a2ml");
+    let back = a2ml::output::read_mcap_bytes(&recording.bytes, "plan.mcap").expect("reads");
+    let mut expected = a2ml::output::RecordedPlan::of(&plan);
+    assert_eq!(back.trajectory, expected.trajectory, "the times exactly");
+    assert_eq!(back.task_source.as_deref(), Some(source.as_str()));
+    assert!(back.urdf.is_some());
+    (expected.urdf, expected.task_source) = (back.urdf.clone(), back.task_source.clone());
+    // The scene as the recording draws it, in {b}.
+    expected.obstacles = task.in_base_frame(&robot.structure.shoulder_in_base_link).scene;
+    assert_eq!(back.obstacles.len(), 5);
+    // Quaternions come back on the hemisphere the recording kept them on.
+    let same = |a: &Option<UnitQuaternion>, b: &Option<UnitQuaternion>| match (a, b) {
+        (Some(a), Some(b)) => a.angle_to(b) < 1e-12,
+        (a, b) => a.is_none() && b.is_none(),
+    };
+    for (a, b) in back.references.iter().zip(&expected.references) {
+        assert!(
+            same(&a.state.ow, &b.state.ow)
+                && same(&a.state.shoulder_frame, &b.state.shoulder_frame)
+        );
+    }
+    for (a, b) in back.segments.iter().zip(&expected.segments) {
+        assert!(same(&a.reference_end.ow, &b.reference_end.ow));
+    }
+    let strip = |p: &mut a2ml::output::RecordedPlan| {
+        for r in &mut p.references {
+            (r.state.ow, r.state.shoulder_frame) = (None, None);
+        }
+        for s in &mut p.segments {
+            (s.reference_end.ow, s.reference_end.shoulder_frame) = (None, None);
+        }
+    };
+    let mut back = back;
+    strip(&mut back);
+    strip(&mut expected);
+    assert_eq!(back, expected);
+}
+
+/// Parses the CSV written for `plan`: header and rows of numbers (`None` for an empty field).
+fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<Option<Real>>>) {
     let text = fs::read_to_string(path).expect("csv written");
     let mut lines = text.lines();
     let header = lines.next().expect("a header").split(',').map(str::to_owned).collect();
     let rows = lines
-        .map(|l| l.split(',').map(|x| x.parse::<Real>().expect("a number")).collect())
+        .map(|l| {
+            l.split(',')
+                .map(|x| (!x.is_empty()).then(|| x.parse::<Real>().expect("a number")))
+                .collect()
+        })
         .collect();
     (header, rows)
+}
+
+/// The reference columns of a state: Pw, Ow (x y z w), θsw, Os (x y z w), θe.
+fn reference_values(state: &ReferenceState) -> Vec<Option<Real>> {
+    let quaternion = |q: Option<UnitQuaternion>| {
+        [q.map(|q| q.i), q.map(|q| q.j), q.map(|q| q.k), q.map(|q| q.w)]
+    };
+    let mut values: Vec<Option<Real>> = (0..3).map(|i| state.pw.map(|p| p[i])).collect();
+    values.extend(quaternion(state.ow));
+    values.push(state.swivel);
+    values.extend(quaternion(state.shoulder_frame));
+    values.push(state.elbow_angle);
+    values
+}
+
+/// Whether two quaternion column groups are the same rotation (q or -q).
+fn same_rotation(a: &[Option<Real>], b: &[Option<Real>]) -> bool {
+    let (a, b): (Vec<Real>, Vec<Real>) =
+        (a.iter().flatten().copied().collect(), b.iter().flatten().copied().collect());
+    a.len() == b.len()
+        && (a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-15)
+            || a.iter().zip(&b).all(|(x, y)| (x + y).abs() < 1e-15))
 }
 
 #[test]
@@ -552,6 +687,14 @@ fn the_csv_holds_every_sample_exactly() {
     let mut expected = vec!["t".to_owned()];
     expected.extend(names.iter().map(|n| format!("{n}_pos")));
     expected.extend(names.iter().map(|n| format!("{n}_vel")));
+    expected.push("ref_segment".to_owned());
+    for v in ["pw_x", "pw_y", "pw_z", "ow_x", "ow_y", "ow_z", "ow_w", "swivel"] {
+        expected.push(format!("ref_{v}"));
+    }
+    for v in ["os_x", "os_y", "os_z", "os_w", "elbow"] {
+        expected.push(format!("ref_{v}"));
+    }
+    expected.push(format!("distance_{}_to_table", robot.capsules[1].name));
     assert_eq!(header, expected);
     assert_eq!(rows.len(), plan.trajectory.len());
     let trajectory = &plan.trajectory;
@@ -563,10 +706,24 @@ fn the_csv_holds_every_sample_exactly() {
             .chain(qd.iter().copied())
             .collect();
         for (read, value) in row.iter().zip(&values) {
+            let read = read.expect("a joint value");
             assert!((read - value).abs() <= 1e-12 * value.abs(), "{read} vs {value}");
         }
-        assert_eq!(row.len(), values.len());
+        let reference = &plan.references[i];
+        assert_eq!(row[15], Some(reference.segment as Real));
+        let expected = reference_values(&reference.state);
+        let read = &row[16..29];
+        assert_eq!(&read[0..3], &expected[0..3], "Pw at sample {i}");
+        assert!(same_rotation(&read[3..7], &expected[3..7]), "Ow at sample {i}");
+        assert_eq!(read[7], expected[7], "θsw at sample {i}");
+        assert!(same_rotation(&read[8..12], &expected[8..12]), "Os at sample {i}");
+        assert_eq!(read[12], expected[12], "θe at sample {i}");
+        assert_eq!(row[29], plan.distances[0].distance[i], "distance at sample {i}");
+        assert_eq!(row.len(), 30);
     }
+    // The table reads back as the trajectory, its other columns aside.
+    let back = a2ml::output::read_csv(&path).expect("reads back");
+    assert_eq!(back.trajectory, plan.trajectory);
 }
 
 #[test]
@@ -588,6 +745,18 @@ fn the_json_is_the_plan_with_its_origin() {
     assert_eq!(q.as_array().map(Vec::len), Some(7));
     assert_eq!(json["segments"][1]["action"], "back");
     assert_eq!(json["warnings"][0], plan.warnings[0].as_str());
+    let reference = &json["references"][70];
+    assert_eq!(reference["segment"], 1);
+    let state = &plan.references[70].state;
+    assert_eq!(reference["swivel"].as_f64(), state.swivel);
+    let pw = state.pw.expect("Pw");
+    assert_eq!(reference["pw"], serde_json::json!([pw.x, pw.y, pw.z]));
+    let ow = state.ow.expect("Ow");
+    assert_eq!(reference["ow"], serde_json::json!([ow.i, ow.j, ow.k, ow.w]), "x y z w");
+    assert_eq!(json["reference_ends"].as_array().map(Vec::len), Some(2));
+    assert_eq!(json["distances"][0]["obstacle"], "table");
+    assert_eq!(json["distances"][0]["distance"][3], Value::Null, "not measured");
+    assert_eq!(json["distances"][0]["distance"][4].as_f64(), plan.distances[0].distance[4]);
 }
 
 #[test]

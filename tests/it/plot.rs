@@ -5,9 +5,11 @@
 use std::path::{Path, PathBuf};
 
 use a2ml::Robot;
-use a2ml::language::{self, Task};
-use a2ml::math::Real;
-use a2ml::output::plot::{PALETTE, Panel, Picture, PlotKind, plot_svg};
+use a2ml::language::{self, Shape, Task, Variable};
+use a2ml::math::{Real, Vector3};
+use a2ml::output::plot::{
+    FeaturedPanel, PALETTE, Panel, Picture, PlotData, PlotKind, Runs, plot_data_svg, plot_svg,
+};
 use a2ml::solve::{self, Plan, PlanOptions, SolveError};
 use resvg::tiny_skia::{Pixmap, Transform};
 use resvg::usvg::{Options, Tree};
@@ -219,4 +221,165 @@ fn the_wrist_path_is_drawn_within_its_extents_in_the_top_view() {
     let sx = (top.x_pixels.1 - top.x_pixels.0) as f64 / (top.x_range.1 - top.x_range.0);
     let sy = (top.y_pixels.0 - top.y_pixels.1) as f64 / (top.y_range.1 - top.y_range.0);
     assert!((sx / sy - 1.0).abs() < 0.02, "x {sx} px/m, y {sy} px/m");
+}
+
+#[test]
+fn plotting_a_recording_draws_what_plotting_the_plan_draws() {
+    let path = example("push_box_aside_coman.a2ml");
+    let (robot, task, plan) = planned(&path);
+    let source = std::fs::read_to_string(&path).expect("example reads");
+    let mcap = Path::new(env!("CARGO_TARGET_TMPDIR")).join("plot-recording.mcap");
+    a2ml::output::write_mcap(&mcap, &robot, &task, &source, &plan).expect("written");
+    let recorded = a2ml::output::read_mcap(&mcap).expect("reads back");
+    // The robot and the task as the recording carries them.
+    let attached = Robot::from_urdf_str(
+        recorded.urdf.as_deref().expect("a URDF"),
+        &a2ml::robot::RobotOptions::default(),
+    )
+    .expect("the URDF loads");
+    let scene = task.in_base_frame(&robot.structure.shoulder_in_base_link).scene;
+    assert_eq!(recorded.obstacles, scene, "the scene as recorded");
+    let from_recording = PlotData::recorded(&attached, &recorded.obstacles, &recorded);
+    let from_plan = PlotData::new(&robot, &task, &plan);
+    assert_eq!(from_recording.featured, from_plan.featured);
+    assert_eq!(from_recording.distances, from_plan.distances);
+    assert_eq!(from_recording.segments, from_plan.segments);
+    let svg = plot_data_svg(&from_recording, PlotKind::All).expect("draws").svg;
+    assert!(svg == plot_svg(&robot, &task, &plan, PlotKind::All).expect("draws").svg);
+}
+
+/// The featured panel of `variable`.
+fn panel_of(data: &PlotData, variable: Variable) -> &FeaturedPanel {
+    data.featured.iter().find(|p| p.variable == variable).expect("a featured panel")
+}
+
+/// The value of `runs` at time `t`, if a point is there.
+fn at(runs: &Runs, t: Real) -> Option<Real> {
+    runs.iter().flatten().find(|p| p.0 == t).map(|p| p.1)
+}
+
+#[test]
+fn each_featured_variable_is_drawn_against_its_reference() {
+    let (robot, task, plan) = planned(&example("construct_goal.a2ml"));
+    let data = PlotData::new(&robot, &task, &plan);
+    let featured: Vec<Variable> = data.featured.iter().map(|p| p.variable).collect();
+    assert_eq!(featured, Variable::ALL, "every variable is featured by some goal");
+    let times = plan.trajectory.times();
+    for k in (0..times.len()).step_by(times.len() / 9) {
+        let (t, r) = (times[k], &plan.references[k]);
+        for (variable, value) in
+            [(Variable::Swivel, r.state.swivel), (Variable::Elbow, r.state.elbow_angle)]
+        {
+            let drawn = at(&panel_of(&data, variable).reference[0].1, t);
+            assert_eq!(drawn, value.map(Real::to_degrees), "{variable:?} at {t} s");
+        }
+        let pw = r.state.pw.expect("Pw is mapped from every HAT reference here");
+        for (i, (_, runs)) in panel_of(&data, Variable::Pw).reference.iter().enumerate() {
+            assert_eq!(at(runs, t), Some(pw[i]), "Pw[{i}] at {t} s");
+        }
+        // A rotation is drawn as its angle to the running segment's reference end while
+        // that segment features it.
+        let segment = &plan.segments[r.segment];
+        for variable in [Variable::Ow, Variable::Os] {
+            let drawn = at(&panel_of(&data, variable).reference[0].1, t);
+            if !segment.focus.contains(&variable) {
+                continue;
+            }
+            let end = &plan.reference_ends[r.segment];
+            let (now, goal) = match variable {
+                Variable::Ow => (r.state.ow, end.ow),
+                _ => (r.state.shoulder_frame, end.shoulder_frame),
+            };
+            let expected = now.zip(goal).map(|(a, b)| a.angle_to(&b).to_degrees());
+            let (drawn, expected) = (drawn.expect("drawn"), expected.expect("defined"));
+            assert!(
+                (drawn - expected).abs() < 1e-4,
+                "{variable:?} at {t} s: {drawn} vs {expected}"
+            );
+        }
+    }
+    // The reference ends where the goal is: θsw's last featuring segment asks 75°.
+    let swivel = panel_of(&data, Variable::Swivel);
+    let last = swivel.targets.last().expect("a goal");
+    assert!((last.2 - 75.0).abs() < 1e-9, "θsw goal {}°", last.2);
+    let reference_end = swivel.reference[0].1.last().and_then(|r| r.last()).expect("drawn");
+    assert!((reference_end.1 - 75.0).abs() < 1e-6, "the reference ends at the goal");
+}
+
+/// Distance from `p` to an axis-aligned box, a sphere or an upright cylinder (negative
+/// inside), by the shapes' own formulas.
+fn distance_to(p: &Vector3, shape: &Shape) -> Real {
+    match shape {
+        Shape::Box { center, size, .. } => {
+            let d = (p - center).abs() - size * 0.5;
+            let outside = d.map(|x| x.max(0.0)).norm();
+            outside + d.max().min(0.0)
+        }
+        Shape::Sphere { center, radius, .. } => (p - center).norm() - radius,
+        Shape::Cylinder { center, radius, height, .. } => {
+            let radial = (p - center).xy().norm() - radius;
+            let axial = (p.z - center.z).abs() - 0.5 * height;
+            let outside = Vector3::new(radial.max(0.0), axial.max(0.0), 0.0).norm();
+            outside + radial.max(axial).min(0.0)
+        }
+        Shape::Capsule { a, b, radius, .. } => segment_distance(p, a, b) - radius,
+    }
+}
+
+fn segment_distance(p: &Vector3, a: &Vector3, b: &Vector3) -> Real {
+    let ab = b - a;
+    let s = if ab.norm_squared() > 0.0 {
+        ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + ab * s)).norm()
+}
+
+#[test]
+fn the_recorded_distances_are_the_distances_of_the_capsules_to_the_obstacles() {
+    let (robot, task, plan) = planned(&example("push_box_aside_coman.a2ml"));
+    let scene = task.in_base_frame(&robot.structure.shoulder_in_base_link).scene;
+    let moving = robot.capsules.iter().filter(|c| c.role != a2ml::robot::LinkRole::Base).count();
+    assert_eq!(plan.distances.len(), moving * scene.len(), "every moving capsule, every obstacle");
+    let n = plan.trajectory.len();
+    let mut checked = 0;
+    for k in [0, n / 5, 2 * n / 5, 3 * n / 5, 4 * n / 5, n - 1] {
+        let q = plan.trajectory.positions()[k];
+        let capsules =
+            a2ml::collision::arm_capsules(&robot, &a2ml::kinematics::arm_pose(&robot, &q));
+        let t = plan.trajectory.times()[k];
+        let running = plan.segments.iter().rev().find(|s| s.start <= t).expect("a segment");
+        let contact = &task.actions[running.action_index].contact;
+        for d in &plan.distances {
+            let value = d.distance[k];
+            if contact.contains(&d.obstacle) {
+                assert_eq!(value, None, "{} is touched on purpose at {t} s", d.obstacle);
+                continue;
+            }
+            let value = value.expect("measured");
+            let capsule = &capsules[d.capsule_index];
+            let obstacle = scene.iter().find(|o| o.name == d.obstacle).expect("an obstacle");
+            // The capsule as its axis sampled every 0.05 mm, each point's distance less the
+            // radius; exact where the capsule is clear of the obstacle.
+            let steps = ((capsule.b - capsule.a).norm() / 5e-5).ceil().max(1.0) as usize;
+            let independent = (0..=steps)
+                .map(|i| {
+                    let p = capsule.a + (capsule.b - capsule.a) * (i as Real / steps as Real);
+                    distance_to(&p, &obstacle.shape)
+                })
+                .fold(Real::INFINITY, Real::min)
+                - capsule.radius;
+            if independent > 0.0 {
+                assert!(
+                    (value - independent).abs() < 1e-5,
+                    "{} to {} at {t} s: {value} recorded, {independent} measured",
+                    d.capsule,
+                    d.obstacle
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 20, "{checked} pairs checked");
 }

@@ -310,8 +310,10 @@ def test_csv_round_trip(plan: Plan, tmp_path: Path) -> None:
     with path.open(encoding="utf-8") as f:
         header = f.readline().strip().split(",")
     names = plan.joint_names
-    assert header == ["t"] + [f"{n}_pos" for n in names] + [f"{n}_vel" for n in names]
-    table = np.loadtxt(path, delimiter=",", skiprows=1)
+    assert header[:15] == ["t"] + [f"{n}_pos" for n in names] + [f"{n}_vel" for n in names]
+    # Then the references (docs/cli.md), a field empty where a value is undefined.
+    assert header[15] == "ref_segment" and header[28] == "ref_elbow"
+    table = np.loadtxt(path, delimiter=",", skiprows=1, usecols=range(15))
     assert table.shape == (len(plan.t), 15)
     # Numbers are written in a form that reads back exactly.
     np.testing.assert_array_equal(table[:, 0], plan.t)

@@ -73,3 +73,29 @@ def test_a_notebook_shows_the_table_and_the_joint_plot(plan: Plan) -> None:
     assert '<table class="segments">' in view
     assert view.count("<tr>") == len(plan.segments) + 1
     assert "<svg" in view and "position" in view
+
+
+def test_the_references_and_distances_are_per_sample(plan: Plan) -> None:
+    import math
+    import pickle
+
+    import numpy as np
+
+    n = len(plan.t)
+    refs = plan.references
+    assert refs["segment"].shape == (n,)
+    assert refs["pw"].shape == (n, 3) and refs["ow"].shape == (n, 4)
+    assert refs["swivel"].shape == (n,) and refs["elbow_angle"].shape == (n,)
+    assert set(refs["segment"].tolist()) == set(range(len(plan.segments)))
+    # Ow's reference is always a unit quaternion (every segment's space has Ow).
+    assert np.allclose(np.linalg.norm(refs["ow"], axis=1), 1.0)
+    distances = plan.distances
+    assert distances, "construct_scene has obstacles"
+    for (capsule, obstacle), values in distances.items():
+        assert isinstance(capsule, str) and isinstance(obstacle, str)
+        assert values.shape == (n,)
+        finite = values[~np.isnan(values)]
+        assert finite.size > 0 and math.isfinite(float(finite.min()))
+    copy = pickle.loads(pickle.dumps(plan))
+    assert np.array_equal(copy.references["pw"], refs["pw"], equal_nan=True)
+    assert list(copy.distances) == list(distances)

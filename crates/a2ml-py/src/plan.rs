@@ -271,6 +271,21 @@ impl PyPlan {
         .into_pyarray(py)
     }
 
+    /// The running segment's references per sample: `segment` (N,), `pw` (N, 3), `ow` and
+    /// `shoulder_frame` (N, 4, quaternions x y z w), `swivel` and `elbow_angle` (N,), in m,
+    /// rad and {b}; NaN where a variable is undefined.
+    #[getter]
+    fn references<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        crate::plot::references(py, &self.plan)
+    }
+
+    /// Each moving arm capsule's signed distance to each obstacle per sample (m), keyed by
+    /// (capsule, obstacle); NaN while the action touches the obstacle on purpose.
+    #[getter]
+    fn distances<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        crate::plot::distances(py, &self.plan)
+    }
+
     /// The distance the solvers kept from obstacles (m).
     #[getter]
     fn safety_distance(&self) -> Real {
@@ -391,6 +406,7 @@ impl PyPlan {
         state.set_item("wrist_reference", this.wrist_reference(py))?;
         state.set_item("safety_distance", this.plan.safety_distance)?;
         state.set_item("warnings", this.warnings())?;
+        state.set_item("per_sample", crate::plot::per_sample_state(&this.plan)?)?;
         let rebuild = slf.get_type().getattr("_from_state")?;
         let args = (this.robot.clone_ref(py), this.task.clone_ref(py), state).into_pyobject(py)?;
         PyTuple::new(py, [rebuild, args.into_any()])
@@ -427,7 +443,11 @@ impl PyPlan {
             wrist_reference,
             safety_distance: item(state, "safety_distance")?.extract()?,
             warnings: item(state, "warnings")?.extract()?,
+            references: Vec::new(),
+            reference_ends: Vec::new(),
+            distances: Vec::new(),
         };
+        let plan = crate::plot::with_per_sample_state(plan, &item(state, "per_sample")?)?;
         Ok(Self { plan, robot, task })
     }
 

@@ -6,11 +6,15 @@ use std::path::Path;
 
 use a2ml_core::Robot;
 use a2ml_core::language::Task;
+use a2ml_core::math::Real;
 use a2ml_core::output::plot::{self, PlotKind};
 use a2ml_core::output::report::{self, ReportInput};
 use a2ml_core::solve::Plan;
+use numpy::IntoPyArray;
+use numpy::ndarray::{Array1, Array2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use crate::{A2mlError, CoreError};
 
@@ -85,4 +89,57 @@ pub(crate) fn notebook(
     plan: &Plan,
 ) -> PyResult<String> {
     py.detach(|| report::notebook_html(robot, task, plan)).map_err(refused)
+}
+
+/// The plan's per-sample references and distances, as JSON text for pickling.
+pub(crate) fn per_sample_state(plan: &Plan) -> PyResult<String> {
+    let parts = (&plan.references, &plan.reference_ends, &plan.distances);
+    serde_json::to_string(&parts).map_err(refused)
+}
+
+/// `plan` with the references and distances of [`per_sample_state`]'s text.
+pub(crate) fn with_per_sample_state(mut plan: Plan, state: &Bound<'_, PyAny>) -> PyResult<Plan> {
+    let text: String = state.extract()?;
+    let (references, reference_ends, distances) = serde_json::from_str(&text)
+        .map_err(|e| PyValueError::new_err(format!("invalid plan state: {e}")))?;
+    plan.references = references;
+    plan.reference_ends = reference_ends;
+    plan.distances = distances;
+    Ok(plan)
+}
+
+/// [`Plan::references`] as arrays, NaN where undefined.
+pub(crate) fn references<'py>(py: Python<'py>, plan: &Plan) -> PyResult<Bound<'py, PyDict>> {
+    let samples = &plan.references;
+    let n = samples.len();
+    let or_nan = |x: Option<Real>| x.unwrap_or(Real::NAN);
+    let out = PyDict::new(py);
+    let segment: Array1<i64> = samples.iter().map(|r| r.segment as i64).collect();
+    out.set_item("segment", segment.into_pyarray(py))?;
+    let pw = Array2::from_shape_fn((n, 3), |(i, j)| or_nan(samples[i].state.pw.map(|p| p[j])));
+    out.set_item("pw", pw.into_pyarray(py))?;
+    let quaternions =
+        |pick: fn(&a2ml_core::solve::ReferenceState) -> Option<a2ml_core::math::UnitQuaternion>| {
+            Array2::from_shape_fn((n, 4), |(i, j)| {
+                or_nan(pick(&samples[i].state).map(|q| q.coords[j]))
+            })
+        };
+    out.set_item("ow", quaternions(|s| s.ow).into_pyarray(py))?;
+    out.set_item("shoulder_frame", quaternions(|s| s.shoulder_frame).into_pyarray(py))?;
+    let angles = |pick: fn(&a2ml_core::solve::ReferenceState) -> Option<Real>| {
+        samples.iter().map(|r| or_nan(pick(&r.state))).collect::<Array1<Real>>()
+    };
+    out.set_item("swivel", angles(|s| s.swivel).into_pyarray(py))?;
+    out.set_item("elbow_angle", angles(|s| s.elbow_angle).into_pyarray(py))?;
+    Ok(out)
+}
+
+/// [`Plan::distances`] keyed by (capsule, obstacle), NaN where not measured.
+pub(crate) fn distances<'py>(py: Python<'py>, plan: &Plan) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    for d in &plan.distances {
+        let values: Array1<Real> = d.distance.iter().map(|x| x.unwrap_or(Real::NAN)).collect();
+        out.set_item((d.capsule.as_str(), d.obstacle.as_str()), values.into_pyarray(py))?;
+    }
+    Ok(out)
 }

@@ -1,6 +1,6 @@
-//! `a2ml plot`: plans a task file (as `a2ml plan` does) and draws the plan as an SVG picture
-//! through the core's [`output::plot`](a2ml_core::output::plot): one kind of chart, or every
-//! kind on one page.
+//! `a2ml plot`: plans a task file (as `a2ml plan` does), or reads a plan's MCAP recording, and
+//! draws the plan as an SVG picture through the core's
+//! [`output::plot`](a2ml_core::output::plot): one kind of chart, or every kind on one page.
 
 use std::path::{Path, PathBuf};
 
@@ -9,7 +9,8 @@ use clap::builder::{PossibleValuesParser, TypedValueParser};
 
 use a2ml_core::{Robot, RobotOptions};
 use a2ml_core::language::Task;
-use a2ml_core::output::plot::{PlotKind, write_plot};
+use a2ml_core::output::plot::{PlotData, PlotKind, write_plot, write_plot_data};
+use a2ml_core::output::{RecordedPlan, read_mcap};
 use a2ml_core::solve::{self, Plan, PlanOptions};
 
 use crate::error::CliError;
@@ -21,6 +22,7 @@ use crate::output;
 Examples:
   a2ml plot examples/type_iv_forward_bar.a2ml -o forward_bar.svg
   a2ml plot task.a2ml -o joints.svg --kind joints
+  a2ml plot plan.mcap -o plan.svg      (a plan written by `a2ml plan --mcap`)
 
 Kinds: joints (positions, limits shaded, segment boundaries numbered),
 velocities (and accelerations, against the speed limits), featured (each
@@ -30,10 +32,12 @@ wrist path in three orthographic views), all (every kind on one page).
 
 Exit codes: 0 success, 1 a file cannot be read or written, 2 the task or an
 option is not valid, 3 a goal is missed beyond tolerance (the picture is
-written all the same), 4 the solver failed (nothing is written).")]
+written all the same), 4 the solver failed (nothing is written).
+An .mcap plan is drawn from its recording: its robot and task are the ones
+attached to it.")]
 pub struct PlotArgs {
-    /// The task file (it is planned first).
-    #[arg(value_name = "TASK.a2ml")]
+    /// The task file (it is planned first), or a plan's .mcap recording.
+    #[arg(value_name = "TASK.a2ml|PLAN.mcap")]
     pub file: PathBuf,
     /// The SVG file to write.
     #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
@@ -106,9 +110,40 @@ pub fn missed(plan: &Plan, what: &str) -> Result<(), CliError> {
 /// [`CliError::Missed`] when the plan, drawn all the same, misses a goal.
 pub fn run(args: &PlotArgs) -> Result<(), CliError> {
     super::plan::check_folder(&args.output)?;
+    if is_recording(&args.file) {
+        return plot_recording(args);
+    }
     let planned = plan_file(&args.file, args.seed)?;
     write_plot(&args.output, &planned.robot, &planned.task, &planned.plan, args.kind)
         .map_err(|e| CliError::Io(e.to_string()))?;
     output::print(&format!("wrote  {}\n", args.output.display()))?;
     missed(&planned.plan, "the picture")
+}
+
+/// Whether `file` is an MCAP recording (by its extension).
+fn is_recording(file: &Path) -> bool {
+    file.extension().is_some_and(|e| e.eq_ignore_ascii_case("mcap"))
+}
+
+/// The robot of a recording, from its attached URDF.
+///
+/// # Errors
+/// [`CliError::Input`] when the URDF is missing, invalid or not the plan's joints.
+pub fn recorded_robot(file: &Path, recorded: &RecordedPlan) -> Result<Robot, CliError> {
+    let urdf = recorded.urdf.as_deref().ok_or_else(|| {
+        CliError::Input(format!("{}: no URDF attached: not a plan written by a2ml", file.display()))
+    })?;
+    let robot = Robot::from_urdf_str(urdf, &RobotOptions::default())
+        .map_err(|e| CliError::Input(format!("{}: the attached URDF: {e}", file.display())))?;
+    recorded.check_joints(&robot.joint_names())?;
+    Ok(robot)
+}
+
+/// `a2ml plot PLAN.mcap`: draws the recorded plan, exit code 3 when a segment missed.
+fn plot_recording(args: &PlotArgs) -> Result<(), CliError> {
+    let recorded = read_mcap(&args.file)?;
+    let robot = recorded_robot(&args.file, &recorded)?;
+    let data = PlotData::recorded(&robot, &recorded.obstacles, &recorded);
+    write_plot_data(&args.output, &data, args.kind).map_err(|e| CliError::Io(e.to_string()))?;
+    output::print(&format!("wrote  {}\n", args.output.display()))
 }

@@ -82,8 +82,10 @@ fn writes_mcap_csv_and_json() {
     let table = fs::read_to_string(&csv).expect("CSV written");
     let mut lines = table.lines();
     let head: Vec<&str> = lines.next().expect("a header").split(',').collect();
-    assert_eq!(head.len(), 1 + 2 * 7, "{head:?}");
+    // t, 7 positions, 7 velocities, the 14 reference columns; no obstacle, no distance.
+    assert_eq!(head.len(), 1 + 2 * 7 + 14, "{head:?}");
     assert_eq!((head[0], head[1], head[8]), ("t", "RShSag_pos", "RShSag_vel"));
+    assert_eq!((head[15], head[28]), ("ref_segment", "ref_elbow"));
     // The total line counts the samples, one CSV row each.
     let samples: usize = total
         .split(", ")

@@ -78,7 +78,9 @@ fn every_example_plots_and_reports() {
         let page = fs::read_to_string(&html).expect("the report is written");
         assert!(page.starts_with("<!doctype html>") && page.trim_end().ends_with("</html>"));
         assert_eq!(external_references(&page), Vec::<String>::new(), "{name}");
-        for section in ["summary", "segments", "motion", "plots", "decomposition", "task"] {
+        for section in
+            ["summary", "segments", "human-likeness", "motion", "plots", "decomposition", "task"]
+        {
             assert!(page.contains(&format!("<section id=\"{section}\">")), "{name}: {section}");
         }
         assert!(page.contains("prefers-color-scheme: dark"), "{name}: a dark style");
@@ -181,4 +183,26 @@ fn a_picture_into_a_missing_folder_is_an_io_error() {
         a2ml(&["plot", &example_path("construct_path_line.a2ml"), "-o", &svg.to_string_lossy()]);
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     assert!(!svg.exists());
+}
+
+#[test]
+fn a_plan_recording_plots_as_its_task_does() {
+    let dir = scratch("plot", "recording");
+    let file = example_path("type_iv_forward_bar.a2ml");
+    let mcap = dir.join("plan.mcap");
+    let out = a2ml(&["plan", &file, "-o", &mcap.to_string_lossy()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let (from_task, from_plan) = (dir.join("task.svg"), dir.join("plan.svg"));
+    let out = a2ml(&["plot", &file, "-o", &from_task.to_string_lossy()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let out = a2ml(&["plot", &mcap.to_string_lossy(), "-o", &from_plan.to_string_lossy()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let (a, b) =
+        (fs::read_to_string(from_task).expect("svg"), fs::read_to_string(from_plan).expect("svg"));
+    assert!(a == b, "the recording draws the same picture");
+    // Not a plan: refused as input.
+    let other = dir.join("not.mcap");
+    fs::write(&other, "not an mcap").expect("written");
+    let out = a2ml(&["plot", &other.to_string_lossy(), "-o", &dir.join("x.svg").to_string_lossy()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
 }

@@ -9,14 +9,14 @@ use mcap::{Attachment, Compression, McapError, WriteOptions, Writer};
 use serde::Serialize;
 
 use super::atomic::Failure;
-use super::messages::{self, JointLimits, StateSeries, Time};
+use super::messages::{self, JointLimits, ReferenceSeries, StateSeries, Time};
 use super::schemas::{self, Schema};
 use super::topics;
 use crate::kinematics::{arm_pose, cpsa_state, hat_state, link_poses};
 use crate::language::Task;
 use crate::math::{Real, Vector3};
 use crate::robot::Robot;
-use crate::solve::{Plan, SegmentReport};
+use crate::solve::{Plan, ReferenceState, SegmentReport};
 
 const JSON: &str = "json";
 const JSON_SCHEMA: &str = "jsonschema";
@@ -61,6 +61,8 @@ struct Topics {
     arm_capsules: Topic,
     wrist_path: Topic,
     state: Topic,
+    reference: Topic,
+    distances: Topic,
     segments: Topic,
     robot_description: Topic,
 }
@@ -85,6 +87,8 @@ fn add_topics<W: Write + Seek>(writer: &mut Writer<W>) -> Result<Topics, Failure
         arm_capsules: add_topic(writer, topics::ARM_CAPSULES, &scene)?,
         wrist_path: add_topic(writer, topics::WRIST_PATH, &scene)?,
         state: add_topic(writer, topics::STATE, &schemas::state())?,
+        reference: add_topic(writer, topics::REFERENCE, &schemas::reference())?,
+        distances: add_topic(writer, topics::DISTANCES, &schemas::distances())?,
         segments: add_topic(writer, topics::SEGMENTS, &schemas::segment())?,
         robot_description: add_topic(
             writer,
@@ -137,6 +141,7 @@ fn metadata(robot: &Robot, task: &Task, plan: &Plan) -> Metadata {
         ("a2ml_version".to_owned(), env!("CARGO_PKG_VERSION").to_owned()),
         ("rate_hz".to_owned(), plan.rate.to_string()),
         ("reached".to_owned(), plan.reached().to_string()),
+        ("safety_distance_m".to_owned(), plan.safety_distance.to_string()),
     ]);
     if !plan.warnings.is_empty() {
         entries.insert("warnings".to_owned(), plan.warnings.join("\n"));
@@ -144,10 +149,11 @@ fn metadata(robot: &Robot, task: &Task, plan: &Plan) -> Metadata {
     Metadata { name: "a2ml".to_owned(), metadata: entries }
 }
 
-/// The segments in start order (stable for equal starts).
-fn by_start(segments: &[SegmentReport]) -> Vec<&SegmentReport> {
-    let mut sorted: Vec<&SegmentReport> = segments.iter().collect();
-    sorted.sort_by(|a, b| a.start.total_cmp(&b.start));
+/// The segments with their references' ends, in start order (stable for equal starts).
+fn by_start(plan: &Plan) -> Vec<(&SegmentReport, Option<&ReferenceState>)> {
+    let mut sorted: Vec<(&SegmentReport, Option<&ReferenceState>)> =
+        plan.segments.iter().enumerate().map(|(i, s)| (s, plan.reference_ends.get(i))).collect();
+    sorted.sort_by(|a, b| a.0.start.total_cmp(&b.0.start));
     sorted
 }
 
@@ -205,20 +211,21 @@ fn write_samples<W: Write + Seek>(
 ) -> Result<(), Failure> {
     let clock = Clock::of(plan);
     let trajectory = &plan.trajectory;
-    let mut segments = by_start(&plan.segments).into_iter().peekable();
+    let mut segments = by_start(plan).into_iter().peekable();
     let mut series = StateSeries::default();
+    let mut reference_series = ReferenceSeries::default();
     let (lower, upper) = (robot.lower(), robot.upper());
     let limits = JointLimits { lower: &lower, upper: &upper };
     let samples =
         trajectory.times().iter().zip(trajectory.positions()).zip(trajectory.velocities());
-    for ((&t, q), qd) in samples {
-        while let Some(segment) = segments.next_if(|s| s.start <= t) {
+    for (k, ((&t, q), qd)) in samples.enumerate() {
+        while let Some(segment) = segments.next_if(|s| s.0.start <= t) {
             write_segment(writer, &mut topics.segments, clock, segment)?;
         }
         let nanos = clock.nanos(t);
         let time = Time::from_nanos(nanos);
         let pose = arm_pose(robot, q);
-        let joints = messages::joint_state(time, &plan.joint_names, q, qd, limits);
+        let joints = messages::joint_state((time, t), &plan.joint_names, q, qd, limits);
         publish(writer, &mut topics.joint_states, nanos, &joints)?;
         let names = robot.links.iter().map(|l| l.name.as_str());
         let tf = messages::frame_transforms(time, names.zip(link_poses(robot, &pose)));
@@ -226,6 +233,15 @@ fn write_samples<W: Write + Seek>(
         let (cpsa, hat) = (cpsa_state(robot, &pose).ok(), hat_state(&pose).ok());
         let state = messages::state(time, cpsa.as_ref(), hat.as_ref(), &mut series);
         publish(writer, &mut topics.state, nanos, &state)?;
+        if let Some(r) = plan.references.get(k) {
+            let message =
+                messages::reference_message(time, r.segment, &r.state, &mut reference_series);
+            publish(writer, &mut topics.reference, nanos, &message)?;
+        }
+        if !plan.distances.is_empty() {
+            let message = messages::distances(time, &plan.distances, k);
+            publish(writer, &mut topics.distances, nanos, &message)?;
+        }
     }
     for segment in segments {
         write_segment(writer, &mut topics.segments, clock, segment)?;
@@ -237,8 +253,9 @@ fn write_segment<W: Write + Seek>(
     writer: &mut Writer<W>,
     topic: &mut Topic,
     clock: Clock,
-    segment: &SegmentReport,
+    (segment, reference_end): (&SegmentReport, Option<&ReferenceState>),
 ) -> Result<(), Failure> {
     let nanos = clock.nanos(segment.start);
-    publish(writer, topic, nanos, &messages::segment(Time::from_nanos(nanos), segment)?)
+    let message = messages::segment(Time::from_nanos(nanos), segment, reference_end)?;
+    publish(writer, topic, nanos, &message)
 }

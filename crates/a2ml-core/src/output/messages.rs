@@ -7,7 +7,8 @@ use crate::kinematics::{CpsaState, HatState};
 use crate::language::{Obstacle, Shape};
 use crate::math::{Isometry, JointVector, Real, Rotation3, UnitQuaternion, Vector3};
 use crate::robot::{LinkRole, Robot};
-use crate::solve::SegmentReport;
+use crate::solve::{ReferenceState, SegmentReport};
+use crate::trajectory::CapsuleDistances;
 
 /// The frame every position is given in: {b}, origin at the shoulder centre.
 pub(super) const BASE_FRAME: &str = "b";
@@ -102,6 +103,7 @@ struct KeyValue {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub(super) struct JointState<'a> {
     timestamp: Time,
+    time: Real,
     name: &'a [String],
     position: &'a [Real],
     velocity: &'a [Real],
@@ -121,7 +123,7 @@ pub(super) struct JointLimits<'a> {
 
 /// The joint state of one sample.
 pub(super) fn joint_state<'a>(
-    time: Time,
+    (time, t): (Time, Real),
     names: &'a [String],
     q: &'a JointVector,
     qd: &'a JointVector,
@@ -129,6 +131,7 @@ pub(super) fn joint_state<'a>(
 ) -> JointState<'a> {
     JointState {
         timestamp: time,
+        time: t,
         name: names,
         position: q.as_slice(),
         velocity: qd.as_slice(),
@@ -448,7 +451,11 @@ pub(super) struct QuaternionSeries {
 impl QuaternionSeries {
     /// The quaternion of `r`, on the side of the previous one.
     pub fn next(&mut self, r: &Rotation3) -> UnitQuaternion {
-        let q = UnitQuaternion::from_rotation_matrix(r);
+        self.next_quaternion(UnitQuaternion::from_rotation_matrix(r))
+    }
+
+    /// `q` or `-q`, whichever is on the side of the previous one.
+    pub fn next_quaternion(&mut self, q: UnitQuaternion) -> UnitQuaternion {
         let q = match self.last {
             Some(last) if last.coords.dot(&q.coords) < 0.0 => {
                 UnitQuaternion::new_unchecked(-q.into_inner())
@@ -488,17 +495,108 @@ pub(super) fn state(
     State { timestamp: time, cpsa, hat }
 }
 
-/// The fields of `a2ml.Segment` that a report may lack; left out of the message then.
-pub(super) const SEGMENT_OPTIONAL: [&str; 4] = ["action_type", "clearance", "rrt", "fallback"];
+/// The five variables of a reference state, each left out where it is undefined.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub(super) struct Reference {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pw: Option<Xyz>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    ow: Option<Quaternion>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    swivel: Option<Real>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    shoulder_frame: Option<Quaternion>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    elbow_angle: Option<Real>,
+}
 
-/// `a2ml.Segment`: the report with its start time, its absent optional fields left out
-/// (Foxglove's schema reader takes one type per field, so "absent" stands for null).
+/// The continuity of the two rotations of [`Reference`] from sample to sample.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct ReferenceSeries {
+    ow: QuaternionSeries,
+    shoulder_frame: QuaternionSeries,
+}
+
+/// A reference state as a message, its quaternions continued along `series`.
+pub(super) fn reference(state: &ReferenceState, series: &mut ReferenceSeries) -> Reference {
+    Reference {
+        pw: state.pw.as_ref().map(Xyz::from),
+        ow: state.ow.map(|q| (&series.ow.next_quaternion(q)).into()),
+        swivel: state.swivel,
+        shoulder_frame: state
+            .shoulder_frame
+            .map(|q| (&series.shoulder_frame.next_quaternion(q)).into()),
+        elbow_angle: state.elbow_angle,
+    }
+}
+
+/// `a2ml.Reference`: what the running segment asks for at one sample.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub(super) struct ReferenceMessage {
+    timestamp: Time,
+    segment: usize,
+    #[serde(flatten)]
+    reference: Reference,
+}
+
+/// The reference of one sample: the segment's index in the plan and its references.
+pub(super) fn reference_message(
+    time: Time,
+    segment: usize,
+    state: &ReferenceState,
+    series: &mut ReferenceSeries,
+) -> ReferenceMessage {
+    ReferenceMessage { timestamp: time, segment, reference: reference(state, series) }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+struct PairDistance<'a> {
+    capsule: &'a str,
+    capsule_index: usize,
+    obstacle: &'a str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    distance: Option<Real>,
+}
+
+/// `a2ml.Distances`: every capsule-obstacle distance of one sample.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub(super) struct Distances<'a> {
+    timestamp: Time,
+    distances: Vec<PairDistance<'a>>,
+}
+
+/// The distances of sample `k`; a pair's distance is left out while it is not measured.
+pub(super) fn distances(time: Time, series: &[CapsuleDistances], k: usize) -> Distances<'_> {
+    let distances = series
+        .iter()
+        .map(|d| PairDistance {
+            capsule: &d.capsule,
+            capsule_index: d.capsule_index,
+            obstacle: &d.obstacle,
+            distance: d.distance.get(k).copied().flatten(),
+        })
+        .collect();
+    Distances { timestamp: time, distances }
+}
+
+/// The fields of `a2ml.Segment` that a report may lack; left out of the message then.
+pub(super) const SEGMENT_OPTIONAL: [&str; 5] =
+    ["action_type", "clearance", "rrt", "fallback", "reference_end"];
+
+/// `a2ml.Segment`: the report with its start time and its references' ends, its absent
+/// optional fields left out (Foxglove's schema reader takes one type per field, so "absent"
+/// stands for null).
 pub(super) fn segment(
     time: Time,
     report: &SegmentReport,
+    reference_end: Option<&ReferenceState>,
 ) -> Result<serde_json::Value, serde_json::Error> {
     let mut fields = serde_json::Map::new();
     fields.insert("timestamp".to_owned(), serde_json::to_value(time)?);
+    if let Some(end) = reference_end {
+        let end = reference(end, &mut ReferenceSeries::default());
+        fields.insert("reference_end".to_owned(), serde_json::to_value(end)?);
+    }
     if let serde_json::Value::Object(report) = serde_json::to_value(report)? {
         let present = |(key, value): &(String, serde_json::Value)| {
             !(value.is_null() && SEGMENT_OPTIONAL.contains(&key.as_str()))

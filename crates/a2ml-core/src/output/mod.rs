@@ -53,7 +53,14 @@ pub mod topics {
     pub const WRIST_PATH: &str = "/wrist_path";
     /// `a2ml.State` per sample: the CPSA and HAT states (null where singular).
     pub const STATE: &str = "/a2ml/state";
-    /// `a2ml.Segment` at each segment's start: its [`crate::solve::SegmentReport`].
+    /// `a2ml.Reference` per sample: what the running segment asks for (its references in
+    /// both spaces, [`crate::solve::Plan::references`]).
+    pub const REFERENCE: &str = "/a2ml/reference";
+    /// `a2ml.Distances` per sample, when the scene has obstacles: each moving arm capsule's
+    /// signed distance to each obstacle ([`crate::solve::Plan::distances`]).
+    pub const DISTANCES: &str = "/a2ml/distances";
+    /// `a2ml.Segment` at each segment's start: its [`crate::solve::SegmentReport`] and its
+    /// references' ends.
     pub const SEGMENTS: &str = "/a2ml/segments";
     /// `std_msgs/String` once at the start: the robot's URDF in `data`, which Foxglove's 3D
     /// panel draws (its visuals) on the `/tf` frames.

@@ -1,5 +1,6 @@
 //! A plan as one self-contained HTML page (issue 18): the task text, its decomposition, the
-//! per-segment table with statuses and warnings, every plot, and the motion itself (the arm's
+//! per-segment table with statuses and warnings, the human-likeness measures (Fitts, HAMP
+//! patterns, RULA, speed shape, jerk: `a2ml analyze`'s), every plot, and the motion itself (the arm's
 //! capsules and the obstacles in a front and a top view) played back with a play button and a
 //! time slider that also marks the time on the plots.
 //!
@@ -15,6 +16,7 @@ use crate::collision::arm_capsules;
 use crate::kinematics::arm_pose;
 use crate::language::{Obstacle, Task, Variable};
 use crate::math::{Real, Vector3};
+use crate::metrics::{self, MetricsOptions, ScoreSummary, Span, SpanMetrics};
 use crate::robot::Robot;
 use crate::solve::{Plan, SegmentReport};
 
@@ -65,6 +67,7 @@ pub fn report_html(input: &ReportInput) -> Result<String, PlotError> {
     );
     summary(&mut out, input);
     segments_table(&mut out, &plan.segments);
+    human_likeness(&mut out, input);
     motion(&mut out, input, &data);
     let _ = write!(
         out,
@@ -247,6 +250,56 @@ pub fn segments_table(out: &mut String, segments: &[SegmentReport]) {
             number_cell(s.limit_margin.to_degrees(), 2),
             escape(&status),
         );
+    }
+    out.push_str("</tbody>\n</table>\n</div>\n</section>\n");
+}
+
+/// `mean / max` of a score, or `-` where no frame was scored.
+fn score(s: Option<ScoreSummary>) -> String {
+    s.map_or_else(|| "-".to_owned(), |s| format!("{} / {}", fixed(s.mean, 2), s.max))
+}
+
+/// One row of the human-likeness table.
+fn measures_row(out: &mut String, m: &SpanMetrics) {
+    let hamp =
+        |h: &metrics::pattern::Hamp| if h.is_empty() { "-".to_owned() } else { h.to_string() };
+    let _ = writeln!(
+        out,
+        "<tr><td>{}</td>{}{}<td>{}</td><td>{}</td>{}<td class=\"n\">{}</td>\
+         <td class=\"n\">{}</td>{}{}<td class=\"n\">{}</td>{}</tr>",
+        escape(&m.span.label),
+        number_cell(m.fitts.duration, 3),
+        number_cell(m.fitts.ratio, 2),
+        escape(&hamp(&m.patterns.phase1.hamp)),
+        escape(&hamp(&m.patterns.phase2.hamp)),
+        number_cell(m.patterns.swivel_ratio, 2),
+        score(m.rula),
+        score(m.rula_sum),
+        number_cell(m.wrist_speed.peak_time_ratio, 2),
+        number_cell(m.wrist_speed.symmetry, 2),
+        m.speed_peaks,
+        number_cell(m.wrist_jerk, 1),
+    );
+}
+
+/// The human-likeness measures of each segment and of the whole motion, as `a2ml analyze`
+/// gives them.
+fn human_likeness(out: &mut String, input: &ReportInput) {
+    let spans = Span::of_plan(input.plan);
+    let analysis =
+        metrics::analyze(input.robot, &input.plan.trajectory, &spans, &MetricsOptions::default());
+    out.push_str(
+        "<section id=\"human-likeness\">\n<h2>Human-likeness</h2>\n<p>Per segment (docs/metrics.md): \
+         T against Fitts' law, the HAMP patterns of the two phases and the swivel share R_Φ, \
+         RULA (arm and wrist score A; upper arm + lower arm + wrist) mean / max, the wrist \
+         speed's peak time over T and symmetry, its peaks (1 is human-like) and normalised \
+         jerk.</p>\n<div class=\"scroll\">\n<table class=\"measures\">\n<thead><tr><th>span</th>\
+         <th>T (s)</th><th>×Fitts</th><th>HAMP 1</th><th>HAMP 2</th><th>R_Φ</th><th>RULA A</th>\
+         <th>UA+LA+W</th><th>peak t/T</th><th>symmetry</th><th>peaks</th><th>jerk</th></tr>\
+         </thead>\n<tbody>\n",
+    );
+    for m in analysis.segments.iter().chain(std::iter::once(&analysis.whole)) {
+        measures_row(out, m);
     }
     out.push_str("</tbody>\n</table>\n</div>\n</section>\n");
 }

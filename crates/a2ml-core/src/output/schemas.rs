@@ -1,6 +1,7 @@
 //! The JSON Schemas of the MCAP channels: Foxglove's own (`foxglove.FrameTransforms`,
 //! `foxglove.SceneUpdate`, field for field as Foxglove publishes them, descriptions left out)
-//! and a2ml's (`a2ml.JointState`, `a2ml.State`, `a2ml.Segment`).
+//! and a2ml's (`a2ml.JointState`, `a2ml.State`, `a2ml.Reference`, `a2ml.Distances`,
+//! `a2ml.Segment`).
 //!
 //! Foxglove reads a JSON Schema into message definitions: every object needs `"type":
 //! "object"` and `properties`, a field has one type (no `["object", "null"]`, no `$ref`), and
@@ -295,6 +296,7 @@ pub(super) fn joint_state() -> Schema {
         Some("a2ml.JointState"),
         json!({
             "timestamp": time(),
+            "time": described("number", "the plan's time (s), exact; timestamp rounds it to ns"),
             "name": array(typed("string")),
             "position": { "type": "array", "items": typed("number"), "description": "rad" },
             "velocity": { "type": "array", "items": typed("number"), "description": "rad/s" },
@@ -309,7 +311,7 @@ pub(super) fn joint_state() -> Schema {
                 "description": "upper position limits (rad)"
             },
         }),
-        &["timestamp", "name", "position", "velocity", "lower", "upper"],
+        &["timestamp", "time", "name", "position", "velocity", "lower", "upper"],
     );
     Schema { name: "a2ml.JointState", body }
 }
@@ -343,6 +345,54 @@ pub(super) fn state() -> Schema {
         &["timestamp"],
     );
     Schema { name: "a2ml.State", body }
+}
+
+/// The properties of a reference state: each variable, absent where it is undefined.
+fn reference_properties() -> Value {
+    json!({
+        "pw": xyz("foxglove.Vector3"),
+        "ow": quaternion(),
+        "swivel": described("number", "θsw (rad)"),
+        "shoulder_frame": quaternion(),
+        "elbow_angle": described("number", "θe (rad)"),
+    })
+}
+
+/// `a2ml.Reference`: what the running segment asks for at one sample, in both spaces.
+pub(super) fn reference() -> Schema {
+    let mut properties = reference_properties();
+    properties["timestamp"] = time();
+    properties["segment"] = described("integer", "index of the running segment in the plan");
+    let mut body = object(Some("a2ml.Reference"), properties, &["timestamp", "segment"]);
+    body["description"] = json!(
+        "the running segment's references (its own space) and their mapping to the other \
+         space; a variable is absent where the mapping is singular"
+    );
+    Schema { name: "a2ml.Reference", body }
+}
+
+/// `a2ml.Distances`: the signed distance of every moving arm capsule to every obstacle.
+pub(super) fn distances() -> Schema {
+    let s = typed("string");
+    let pair = object(
+        None,
+        json!({
+            "capsule": s,
+            "capsule_index": described("integer", "the capsule's index in the robot's list"),
+            "obstacle": s,
+            "distance": described(
+                "number",
+                "signed distance (m); absent while the action touches the obstacle on purpose"
+            ),
+        }),
+        &["capsule", "capsule_index", "obstacle"],
+    );
+    let body = object(
+        Some("a2ml.Distances"),
+        json!({ "timestamp": time(), "distances": array(pair) }),
+        &["timestamp", "distances"],
+    );
+    Schema { name: "a2ml.Distances", body }
 }
 
 /// `a2ml.Segment`: a [`crate::solve::SegmentReport`] with the time it starts.
@@ -395,13 +445,18 @@ pub(super) fn segment() -> Schema {
             "qp_stalled, qp_missed_goal or qp_left_path: why auto went on from the QP to the \
              solver named; absent if it did not"
         ),
-           "peak_velocity_ratio": described("number", "largest |q'|/limit over the segment"),
+        "peak_velocity_ratio": described("number", "largest |q'|/limit over the segment"),
         "peak_acceleration_ratio": described("number", "largest |q''|/limit over the segment"),
         "limits_kept": b,
         "slowed_down": described("number", "factor the segment was slowed by (1: as solved)"),
         "joint_jerk": described("number", "normalised jerk of the joints (dimensionless)"),
         "wrist_jerk": described("number", "normalised jerk of the wrist path (dimensionless)"),
         "speed_peaks": described("integer", "peaks of the featured variable's speed"),
+        "reference_end": {
+            "type": "object",
+            "description": "the references at the segment's end T: goals, path ends, holds",
+            "properties": reference_properties(),
+        },
     });
     let required: Vec<&str> = fields
         .as_object()

@@ -26,6 +26,7 @@ pub(crate) mod plan;
 pub mod pmp;
 pub mod problem;
 pub mod qp;
+mod references;
 mod report;
 pub mod rrt;
 pub mod timing;
@@ -34,4 +35,7 @@ mod tree;
 pub use checks::CheckError;
 pub use monitor::Monitor;
 pub use plan::{PlanOptions, Progress, SolveError, plan, plan_with_progress};
-pub use report::{Fallback, Plan, QpStats, SegmentReport, Tolerance, VariableError};
+pub use report::{
+    Fallback, Plan, QpStats, ReferenceSample, ReferenceState, SegmentReport, Tolerance,
+    VariableError,
+};

@@ -21,6 +21,7 @@ use super::map::{MapError, MapOptions, map_segment};
 use super::monitor::{Monitor, deadline_after};
 use super::problem::{Component, SegmentProblem};
 use super::qp::{self, QpError, QpOptions};
+use super::references::{Placed, reference_ends, reference_samples};
 use super::report::{Fallback, Plan, QpStats, SegmentReport, Tolerance, VariableError};
 use super::rrt::{RrtError, RrtOptions, RrtStats, rrt_connect_monitored};
 use super::timing::{TimedPath, time_constrained, time_parameterise};
@@ -36,7 +37,7 @@ use crate::math::{DOF, JointVector, Real, Vector3};
 use crate::metrics::smoothness::{normalised_jerk, speed_peaks};
 use crate::profile::{BodyFrames, ProfileError, Reference, Role, Sample};
 use crate::robot::Robot;
-use crate::trajectory::{self, Limits, Trajectory, TrajectoryError, peaks};
+use crate::trajectory::{self, Limits, Trajectory, TrajectoryError, capsule_distances, peaks};
 
 /// Settings of [`plan`].
 ///
@@ -319,12 +320,25 @@ pub fn plan_with_progress(
     if !task.scene.is_empty() {
         warnings.extend(robot.geometry_warnings.iter().map(|w| format!("collision geometry: {w}")));
     }
+    let placed: Vec<Placed> = state
+        .pieces
+        .iter()
+        .map(|p| Placed { start: p.start, stretch: p.stretch, problem: &p.problem })
+        .collect();
+    let references = reference_samples(robot, &placed, whole.times());
+    let reference_ends = reference_ends(robot, &placed);
     let mut segments = Vec::with_capacity(state.pieces.len());
     let mut wrist_reference = Vec::new();
     for piece in state.pieces {
         wrist_reference.extend(piece.reference.iter().map(|(t, p)| (piece.start + t, *p)));
         segments.push(piece.report);
     }
+    let distances = capsule_distances(&whole, robot, &task_b.scene, |sample, obstacle| {
+        let t = whole.times()[sample];
+        segments.iter().rev().find(|s| s.start <= t).is_some_and(|s: &SegmentReport| {
+            task.actions[s.action_index].contact.iter().any(|c| c == obstacle)
+        })
+    });
     let safety = options.safety_distance;
     warnings.extend(segments.iter().filter_map(|s| checks::too_close(s, safety)));
     warnings.extend(segments.iter().filter(|s| !s.reached).map(missed));
@@ -339,6 +353,9 @@ pub fn plan_with_progress(
         wrist_reference,
         safety_distance: options.safety_distance,
         warnings,
+        references,
+        reference_ends,
+        distances,
     })
 }
 
@@ -356,6 +373,8 @@ struct Piece {
     report: SegmentReport,
     /// The reference wrist path, in the segment's own time.
     reference: Vec<(Real, Vector3)>,
+    /// The segment's references, for [`Plan::references`].
+    problem: SegmentProblem,
     /// The factor the segment is slowed down by (1: as solved).
     stretch: Real,
     /// Start in the plan's time (s), once joined.
@@ -469,6 +488,7 @@ impl Solver<'_> {
                 trajectory: solution.trajectory,
                 report,
                 reference,
+                problem: job.problem,
                 stretch: 1.0,
                 start: 0.0,
             });

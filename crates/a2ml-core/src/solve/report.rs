@@ -3,8 +3,8 @@
 
 use crate::decompose::{ActionType, SegmentPattern};
 use crate::language::{SolverChoice, Space, Variable};
-use crate::math::{Real, Vector3};
-use crate::trajectory::{Clearance, Trajectory};
+use crate::math::{Real, UnitQuaternion, Vector3};
+use crate::trajectory::{CapsuleDistances, Clearance, Trajectory};
 
 /// How close a goal must be reached.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -202,6 +202,15 @@ pub struct Plan {
     pub safety_distance: Real,
     /// Goals missed beyond tolerance and solver fallbacks, each naming the action and segment.
     pub warnings: Vec<String>,
+    /// What the running segment asked for at each sample of `trajectory` (empty without a
+    /// segment): its references at that instant, slowed as the segment was, held at their
+    /// ends past T.
+    pub references: Vec<ReferenceSample>,
+    /// Each segment's references at its end T, in the order of `segments`: its goals, the
+    /// ends of its paths, its holds.
+    pub reference_ends: Vec<ReferenceState>,
+    /// The distance of every moving arm capsule to every obstacle at each sample.
+    pub distances: Vec<CapsuleDistances>,
 }
 
 impl Plan {
@@ -210,4 +219,31 @@ impl Plan {
     pub fn reached(&self) -> bool {
         self.segments.iter().all(|s| s.reached && s.path_kept && s.limits_kept)
     }
+}
+
+/// A state of the five variables as a reference gives it: the segment's own space from its
+/// references, the other space mapped from them (`None` where the mapping is singular).
+/// Rotations as unit quaternions, serialised `[x, y, z, w]`.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct ReferenceState {
+    /// Pw in {b} (m).
+    pub pw: Option<Vector3>,
+    /// Ow in {b}.
+    pub ow: Option<UnitQuaternion>,
+    /// θsw (rad).
+    pub swivel: Option<Real>,
+    /// Os in {b}.
+    pub shoulder_frame: Option<UnitQuaternion>,
+    /// θe (rad).
+    pub elbow_angle: Option<Real>,
+}
+
+/// The reference state at one sample of the plan and the segment it belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ReferenceSample {
+    /// Index in [`Plan::segments`] of the segment running at the sample (the latest to start).
+    pub segment: usize,
+    /// Its references there.
+    #[serde(flatten)]
+    pub state: ReferenceState,
 }

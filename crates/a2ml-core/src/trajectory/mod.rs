@@ -2,7 +2,8 @@
 //! (docs/design.md §4, §5) and the checks run on the whole result: joint limits and clearance.
 //!
 //! Entry points: [`Trajectory::new`], [`join_sequential`], [`join_transitional`],
-//! [`check_limits`], [`peaks`], [`min_clearance`], [`sample_times`] (the output grid),
+//! [`check_limits`], [`peaks`], [`min_clearance`], [`capsule_distances`] (per sample),
+//! [`sample_times`] (the output grid),
 //! [`Trajectory::stretched`]. Between samples q follows the cubic Hermite curve through the
 //! samples' q and q', so the two stay consistent and the limits are checked at every instant
 //! of that curve, not only at the samples.
@@ -13,10 +14,12 @@ use crate::math::{DOF, JointVector, Real};
 use crate::profile::{self, JointSample, ProfileError, SequentialOptions, Transition};
 use crate::robot::Robot;
 
+mod distances;
 mod limits;
 #[cfg(test)]
 mod tests;
 
+pub use distances::{CapsuleDistances, capsule_distances};
 pub use limits::{Limits, Peaks, peaks};
 
 /// Largest |q2(0) - q1(T1)| per joint accepted by [`join_sequential`] (rad).

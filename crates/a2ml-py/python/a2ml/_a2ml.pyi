@@ -643,6 +643,21 @@ class Plan:
         rows ``(t, x, y, z)`` in s and m, in {b}, at :attr:`rate`."""
 
     @property
+    def references(self) -> dict[str, NDArray[Any]]:
+        """What the running segment asked for at each sample: ``segment`` (N,)
+        its index in :attr:`segments`, ``pw`` (N, 3) in m, ``ow`` and
+        ``shoulder_frame`` (N, 4) as quaternions ``(x, y, z, w)``, ``swivel``
+        and ``elbow_angle`` (N,) in rad, all in {b}: the segment's own space
+        from its references, the other mapped from them; NaN where
+        undefined."""
+
+    @property
+    def distances(self) -> dict[tuple[str, str], NDArray[np.float64]]:
+        """Each moving arm capsule's signed distance to each obstacle at every
+        sample (m), keyed by ``(capsule, obstacle)``; NaN while the running
+        action touches the obstacle on purpose (``contact``)."""
+
+    @property
     def safety_distance(self) -> float:
         """The distance the solvers kept from obstacles (m)."""
 

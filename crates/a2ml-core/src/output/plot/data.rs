@@ -2,16 +2,12 @@
 //! plan's time, the limits, the segments, the clearances and the scene's outlines. Drawing
 //! reads only this.
 
-use crate::collision::{self, CollisionScene, DistanceOptions};
-use crate::decompose::{ArmState, DecomposeOptions, PlannedSegment, decompose};
-use crate::kinematics::arm_pose;
-use crate::language::{Obstacle, PathFeature, PrimitiveConstraint, Target, Task, Variable};
+use crate::decompose::ArmState;
+use crate::language::{Obstacle, SolverChoice, Target, Task, Variable};
 use crate::math::{DOF, JointVector, Real, Rotation3, Vector3};
+use crate::output::{RecordedPlan, RecordedSegment};
 use crate::robot::Robot;
-use crate::solve::{Plan, SegmentReport};
-
-/// Far enough that every capsule-obstacle pair of a workspace is measured (m).
-const EVERY_PAIR: Real = 1e3;
+use crate::solve::{Plan, ReferenceSample, ReferenceState};
 
 /// One segment as the plots mark it.
 #[derive(Debug, Clone, PartialEq)]
@@ -99,19 +95,20 @@ pub struct PlotData {
 }
 
 impl PlotData {
-    /// Takes out of `plan` (made from `task` on `robot`) what the plots draw. The goals drawn
-    /// against the featured variables are the decomposition's, with default options, as
-    /// `solve::plan` uses them.
+    /// Takes out of `plan` (made from `task` on `robot`) what the plots draw.
     pub fn new(robot: &Robot, task: &Task, plan: &Plan) -> Self {
         let task_b = task.in_base_frame(&robot.structure.shoulder_in_base_link);
+        Self::recorded(robot, &task_b.scene, &RecordedPlan::of(plan))
+    }
+
+    /// Takes out of a plan read back from its recording what the plots draw; `obstacles` are
+    /// the task's scene in {b}. A plan and its MCAP recording give the same data.
+    pub fn recorded(robot: &Robot, obstacles: &[Obstacle], plan: &RecordedPlan) -> Self {
         let times = plan.trajectory.times().to_vec();
         let q = plan.trajectory.positions().to_vec();
         let qd = plan.trajectory.velocities().to_vec();
         let states: Vec<Option<ArmState>> = q.iter().map(|q| ArmState::at(robot, q).ok()).collect();
-        let planned = decompose(robot, task, &DecomposeOptions::default())
-            .map(|d| d.actions.into_iter().map(|a| (a.index, a.segments)).collect::<Vec<_>>())
-            .unwrap_or_default();
-        let featured = featured_panels(plan, &times, &states, &planned);
+        let featured = featured_panels(plan, &times, &states);
         Self {
             caption: caption(robot, plan),
             joint_names: plan.joint_names.clone(),
@@ -122,11 +119,11 @@ impl PlotData {
             segments: marks(plan),
             featured,
             capsules: robot.capsules.iter().map(|c| c.name.clone()).collect(),
-            distances: distances(robot, &task_b, plan, &times, &q),
-            safety_distance: plan.safety_distance,
+            distances: distances(plan, &times),
+            safety_distance: plan.safety_distance.unwrap_or(0.0),
             wrist: states.iter().flatten().map(|s| s.cpsa.pw).collect(),
-            wrist_reference: plan.wrist_reference.iter().map(|(_, p)| *p).collect(),
-            obstacles: task_b.scene.clone(),
+            wrist_reference: plan.wrist_reference.clone(),
+            obstacles: obstacles.to_vec(),
             times,
             q,
             qd,
@@ -142,19 +139,20 @@ impl PlotData {
 }
 
 /// `task push · robot iiwa14 · solver qp, rrt`.
-fn caption(robot: &Robot, plan: &Plan) -> String {
+fn caption(robot: &Robot, plan: &RecordedPlan) -> String {
     let mut solvers: Vec<&str> = Vec::new();
-    for s in &plan.segments {
-        if !solvers.contains(&s.solver.name()) {
-            solvers.push(s.solver.name());
+    for s in plan.segments.iter().filter_map(|s| s.solver) {
+        if !solvers.contains(&s.name()) {
+            solvers.push(s.name());
         }
     }
     let solvers = if solvers.is_empty() { "-".to_owned() } else { solvers.join(", ") };
-    format!("task {} · robot {} · solver {solvers}", plan.task, robot.name)
+    let task = plan.task.as_deref().unwrap_or("-");
+    format!("task {task} · robot {} · solver {solvers}", robot.name)
 }
 
 /// The segments with their numbers and labels.
-fn marks(plan: &Plan) -> Vec<SegmentMark> {
+fn marks(plan: &RecordedPlan) -> Vec<SegmentMark> {
     plan.segments
         .iter()
         .enumerate()
@@ -167,7 +165,7 @@ fn marks(plan: &Plan) -> Vec<SegmentMark> {
                 s.action,
                 s.segment + 1,
                 s.action_type.map_or("-", |t| t.numeral()),
-                s.solver.name()
+                s.solver.map_or("-", SolverChoice::name)
             ),
         })
         .collect()
@@ -205,96 +203,21 @@ pub(super) fn runs(points: impl Iterator<Item = (Real, Option<Real>)>) -> Runs {
     out
 }
 
-/// Every moving capsule's distance to every obstacle of the scene, left out (a gap) during
-/// the actions that touch the obstacle on purpose (`contact`).
-fn distances(
-    robot: &Robot,
-    task: &Task,
-    plan: &Plan,
-    times: &[Real],
-    q: &[JointVector],
-) -> Vec<DistanceSeries> {
-    let options = DistanceOptions { influence: EVERY_PAIR };
-    let scenes: Vec<CollisionScene> =
-        task.scene.iter().map(|o| CollisionScene::new(std::slice::from_ref(o))).collect();
-    // Per sample and obstacle, the distance of every moving capsule (by name).
-    let measured: Vec<Vec<Vec<(String, Real)>>> = q
+/// The recorded distance of every capsule-obstacle pair over time, a gap where it was not
+/// measured (the action touches the obstacle on purpose).
+fn distances(plan: &RecordedPlan, times: &[Real]) -> Vec<DistanceSeries> {
+    plan.distances
         .iter()
-        .map(|q| {
-            let pose = arm_pose(robot, q);
-            scenes
-                .iter()
-                .map(|scene| {
-                    collision::distances(robot, &pose, scene, &options)
-                        .into_iter()
-                        .filter(|p| p.obstacle_frame.is_none())
-                        .map(|p| (p.link, p.distance))
-                        .collect()
-                })
-                .collect()
+        .filter_map(|d| {
+            let runs = runs(times.iter().zip(&d.distance).map(|(&t, d)| (t, *d)));
+            (!runs.is_empty()).then(|| DistanceSeries {
+                capsule: d.capsule.clone(),
+                capsule_index: d.capsule_index,
+                obstacle: d.obstacle.clone(),
+                runs,
+            })
         })
-        .collect();
-    let contact_at = |t: Real, obstacle: &str| {
-        action_at(plan, t).is_some_and(|a| {
-            task.actions.get(a).is_some_and(|a| a.contact.iter().any(|c| c == obstacle))
-        })
-    };
-    let mut out = Vec::new();
-    for (k, obstacle) in task.scene.iter().enumerate() {
-        for (capsule_index, capsule) in robot.capsules.iter().enumerate() {
-            let values = times.iter().zip(&measured).map(|(&t, per_obstacle)| {
-                let d = per_obstacle.get(k).and_then(|pairs| {
-                    pairs.iter().find(|(name, _)| *name == capsule.name).map(|(_, d)| *d)
-                });
-                (t, if contact_at(t, &obstacle.name) { None } else { d })
-            });
-            let runs = runs(values);
-            if !runs.is_empty() {
-                out.push(DistanceSeries {
-                    capsule: capsule.name.clone(),
-                    capsule_index,
-                    obstacle: obstacle.name.clone(),
-                    runs,
-                });
-            }
-        }
-    }
-    out
-}
-
-/// The decomposition's segment that `s` solved.
-fn planned_segment<'p>(
-    planned: &'p [(usize, Vec<PlannedSegment>)],
-    s: &SegmentReport,
-) -> Option<&'p PlannedSegment> {
-    planned.iter().find(|(index, _)| *index == s.action_index)?.1.get(s.segment)
-}
-
-/// The index in `Task::actions` of the action running at time `t`.
-fn action_at(plan: &Plan, t: Real) -> Option<usize> {
-    plan.segments.iter().rev().find(|s| s.start <= t).map(|s| s.action_index)
-}
-
-/// A segment's target for `variable`: the goal's value, or the path's end for a sized
-/// rotation `about` an axis (as an angle from the segment's start).
-enum Asked {
-    Goal(Target),
-    Turn(Real),
-    Hold,
-}
-
-fn asked(segment: &PlannedSegment, variable: Variable) -> Option<Asked> {
-    segment.primitives.iter().find_map(|p| {
-        let i = p.variables.iter().position(|v| *v == variable)?;
-        Some(match &p.constraint {
-            PrimitiveConstraint::Goal(targets) => Asked::Goal(*targets.get(i)?),
-            PrimitiveConstraint::Path(PathFeature::About { angle: Some(a), .. }) => {
-                Asked::Turn(a.abs())
-            }
-            PrimitiveConstraint::Path(_) => return None,
-            PrimitiveConstraint::Hold => Asked::Hold,
-        })
-    })
+        .collect()
 }
 
 fn rotation_of(state: &ArmState, variable: Variable) -> Option<Rotation3> {
@@ -311,51 +234,69 @@ fn angle_of(state: &ArmState, variable: Variable) -> Option<Real> {
     }
 }
 
+/// A rotation variable of a reference state.
+fn reference_rotation(state: &ReferenceState, variable: Variable) -> Option<Rotation3> {
+    let q = match variable {
+        Variable::Ow => state.ow,
+        Variable::Os => state.shoulder_frame,
+        _ => None,
+    };
+    q.map(|q| q.to_rotation_matrix())
+}
+
+/// An angle variable of a reference state (rad).
+fn reference_angle(state: &ReferenceState, variable: Variable) -> Option<Real> {
+    match variable {
+        Variable::Swivel => state.swivel,
+        Variable::Elbow => state.elbow_angle,
+        _ => None,
+    }
+}
+
 /// One panel per featured variable, in the order the variables are listed.
 fn featured_panels(
-    plan: &Plan,
+    plan: &RecordedPlan,
     times: &[Real],
     states: &[Option<ArmState>],
-    planned: &[(usize, Vec<PlannedSegment>)],
 ) -> Vec<FeaturedPanel> {
     Variable::ALL
         .iter()
         .filter_map(|&variable| {
-            let featuring: Vec<&SegmentReport> =
-                plan.segments.iter().filter(|s| s.focus.contains(&variable)).collect();
+            let featuring: Vec<(usize, &RecordedSegment)> = plan
+                .segments
+                .iter()
+                .enumerate()
+                .filter(|(_, s)| s.focus.contains(&variable))
+                .collect();
             if featuring.is_empty() {
                 return None;
             }
-            let spans = featuring.iter().map(|s| (s.start, s.end)).collect();
             let mut panel = match variable {
                 Variable::Pw => wrist_panel(plan, times, states),
-                Variable::Swivel | Variable::Elbow => angle_panel(variable, times, states),
+                Variable::Swivel | Variable::Elbow => angle_panel(variable, plan, times, states),
                 Variable::Ow | Variable::Os => {
-                    rotation_panel(variable, &featuring, times, states, planned)
+                    rotation_panel(variable, &featuring, plan, times, states)
                 }
             };
-            panel.spans = spans;
-            for s in &featuring {
-                let Some(asked) = planned_segment(planned, s).and_then(|p| asked(p, variable))
-                else {
-                    continue;
-                };
-                match (variable, asked) {
-                    (Variable::Pw, Asked::Goal(Target::Position(p))) => {
-                        for (k, value) in [p.x, p.y, p.z].into_iter().enumerate() {
+            panel.spans = featuring.iter().map(|(_, s)| (s.start, s.end)).collect();
+            for (_, s) in &featuring {
+                let end = &s.reference_end;
+                match variable {
+                    Variable::Pw => {
+                        for (k, value) in end.pw.iter().flat_map(|p| [p.x, p.y, p.z]).enumerate() {
                             panel.targets.push((s.start, s.end, value, k));
                         }
                     }
-                    (Variable::Swivel | Variable::Elbow, Asked::Goal(Target::Angle(a))) => {
-                        panel.targets.push((s.start, s.end, a.to_degrees(), 0));
+                    Variable::Swivel | Variable::Elbow => {
+                        if let Some(a) = reference_angle(end, variable) {
+                            panel.targets.push((s.start, s.end, a.to_degrees(), 0));
+                        }
                     }
-                    (Variable::Ow | Variable::Os, Asked::Goal(_) | Asked::Hold) => {
-                        panel.targets.push((s.start, s.end, 0.0, 0));
+                    Variable::Ow | Variable::Os => {
+                        if reference_rotation(end, variable).is_some() {
+                            panel.targets.push((s.start, s.end, 0.0, 0));
+                        }
                     }
-                    (Variable::Ow | Variable::Os, Asked::Turn(a)) => {
-                        panel.targets.push((s.start, s.end, a.to_degrees(), 0));
-                    }
-                    _ => {}
                 }
             }
             Some(panel)
@@ -363,12 +304,21 @@ fn featured_panels(
         .collect()
 }
 
+/// The reference of each sample, where it gives `value`.
+fn reference_runs(
+    plan: &RecordedPlan,
+    times: &[Real],
+    value: impl Fn(&ReferenceSample) -> Option<Real>,
+) -> Runs {
+    runs(times.iter().zip(&plan.references).map(|(&t, r)| (t, value(r))))
+}
+
 /// Pw's components against the reference the segments followed.
-fn wrist_panel(plan: &Plan, times: &[Real], states: &[Option<ArmState>]) -> FeaturedPanel {
+fn wrist_panel(plan: &RecordedPlan, times: &[Real], states: &[Option<ArmState>]) -> FeaturedPanel {
     let component = |k: usize| {
         runs(times.iter().zip(states).map(|(&t, s)| (t, s.as_ref().map(|s| s.cpsa.pw[k]))))
     };
-    let reference = |k: usize| runs(plan.wrist_reference.iter().map(|(t, p)| (*t, Some(p[k]))));
+    let reference = |k: usize| reference_runs(plan, times, |r| r.state.pw.map(|p| p[k]));
     let names = ["x", "y", "z"];
     FeaturedPanel {
         variable: Variable::Pw,
@@ -380,56 +330,61 @@ fn wrist_panel(plan: &Plan, times: &[Real], states: &[Option<ArmState>]) -> Feat
     }
 }
 
-/// θsw or θe over the whole plan (deg).
-fn angle_panel(variable: Variable, times: &[Real], states: &[Option<ArmState>]) -> FeaturedPanel {
+/// θsw or θe over the whole plan (deg), against the running segment's reference.
+fn angle_panel(
+    variable: Variable,
+    plan: &RecordedPlan,
+    times: &[Real],
+    states: &[Option<ArmState>],
+) -> FeaturedPanel {
     let values = times
         .iter()
         .zip(states)
         .map(|(&t, s)| (t, s.as_ref().and_then(|s| angle_of(s, variable)).map(Real::to_degrees)));
+    let reference =
+        reference_runs(plan, times, |r| reference_angle(&r.state, variable).map(Real::to_degrees));
+    let symbol = variable.symbol().to_owned();
     FeaturedPanel {
         variable,
         axis: format!("{} (°)", variable.symbol()),
-        actual: vec![(variable.symbol().to_owned(), runs(values))],
-        reference: Vec::new(),
+        actual: vec![(symbol.clone(), runs(values))],
+        reference: vec![(symbol, reference)],
         targets: Vec::new(),
         spans: Vec::new(),
     }
 }
 
-/// Ow or Os over the segments that feature it: the angle to the segment's goal (0 is
-/// reached), or the angle turned from the segment's start for a path about an axis (deg).
+/// Ow or Os over the segments that feature it: the angle to the segment's reference end (its
+/// goal, or the end of its path; 0 is reached), planned and reference (deg).
 fn rotation_panel(
     variable: Variable,
-    featuring: &[&SegmentReport],
+    featuring: &[(usize, &RecordedSegment)],
+    plan: &RecordedPlan,
     times: &[Real],
     states: &[Option<ArmState>],
-    planned: &[(usize, Vec<PlannedSegment>)],
 ) -> FeaturedPanel {
-    let mut runs_all: Runs = Vec::new();
-    for s in featuring {
-        let inside =
-            || times.iter().zip(states).filter(move |(t, _)| **t >= s.start && **t <= s.end);
-        let first =
-            inside().find_map(|(_, st)| st.as_ref().and_then(|st| rotation_of(st, variable)));
-        let from = match planned_segment(planned, s).and_then(|p| asked(p, variable)) {
-            Some(Asked::Goal(Target::Rotation(goal))) => Some(goal),
-            Some(Asked::Turn(_) | Asked::Hold) => first,
-            _ => None,
-        };
-        let Some(from) = from else { continue };
-        runs_all.extend(runs(inside().map(|(&t, st)| {
+    let (mut actual, mut reference): (Runs, Runs) = (Vec::new(), Vec::new());
+    for (index, s) in featuring {
+        let Some(end) = reference_rotation(&s.reference_end, variable) else { continue };
+        let inside = times.iter().zip(states).filter(|(t, _)| **t >= s.start && **t <= s.end);
+        actual.extend(runs(inside.map(|(&t, st)| {
             let angle = st
                 .as_ref()
                 .and_then(|st| rotation_of(st, variable))
-                .map(|r| r.angle_to(&from).to_degrees());
+                .map(|r| r.angle_to(&end).to_degrees());
             (t, angle)
         })));
+        let own = times.iter().zip(&plan.references).filter(|(_, r)| r.segment == *index);
+        reference.extend(runs(own.map(|(&t, r)| {
+            (t, reference_rotation(&r.state, variable).map(|r| r.angle_to(&end).to_degrees()))
+        })));
     }
+    let label = format!("{} to goal or path end", variable.symbol());
     FeaturedPanel {
         variable,
         axis: format!("{} angle (°)", variable.symbol()),
-        actual: vec![(format!("{} to goal or from start", variable.symbol()), runs_all)],
-        reference: Vec::new(),
+        actual: vec![(label.clone(), actual)],
+        reference: vec![(label, reference)],
         targets: Vec::new(),
         spans: Vec::new(),
     }

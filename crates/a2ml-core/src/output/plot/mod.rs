@@ -140,6 +140,18 @@ pub fn plot_data_svg(data: &PlotData, kind: PlotKind) -> Result<Picture, PlotErr
     draw::picture(data, kind)
 }
 
+/// Writes `kind` of the plot data as an SVG file, through a temporary file renamed into place.
+///
+/// # Errors
+/// As [`write_plot`].
+pub fn write_plot_data(path: &Path, data: &PlotData, kind: PlotKind) -> Result<(), OutputError> {
+    let picture = plot_data_svg(data, kind).map_err(|e| OutputError::Plot {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    super::write_text(path, &picture.svg)
+}
+
 /// Writes `kind` of `plan` as an SVG file, through a temporary file renamed into place.
 ///
 /// # Errors
@@ -152,9 +164,5 @@ pub fn write_plot(
     plan: &Plan,
     kind: PlotKind,
 ) -> Result<(), OutputError> {
-    let picture = plot_svg(robot, task, plan, kind).map_err(|e| OutputError::Plot {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
-    super::write_text(path, &picture.svg)
+    write_plot_data(path, &PlotData::new(robot, task, plan), kind)
 }
