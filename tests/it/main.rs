@@ -6,6 +6,7 @@ mod common;
 mod constrained_rrt;
 mod decompose;
 mod errors;
+mod foxglove_layout;
 mod hamp;
 mod hostile;
 mod ik;

@@ -10,6 +10,7 @@ mod language;
 mod outputs;
 mod plan;
 mod plot;
+mod progress;
 mod robot;
 
 use std::fs;
