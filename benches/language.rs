@@ -21,7 +21,9 @@ fn generated_task(n: usize) -> String {
             0 => format!(
                 "  action a{i} {{\n    goal Pw Ow = ([0.25, -0.28, -0.05], rpy(180, 0, 90) deg) > Os = axes(r: [0, 0, -1], l: [0, 1, 0])\n    duration 2 s\n  }}\n"
             ),
-            1 => format!("  action a{i} {{\n    path Pw line [0, 1, 0] 12 cm, Ow hold, θsw hold : hard\n  }}\n"),
+            1 => format!(
+                "  action a{i} {{\n    path Pw line [0, 1, 0] 12 cm, Ow hold, θsw hold : hard\n  }}\n"
+            ),
             2 => format!(
                 "  action a{i} {{\n    goal Pw Ow = ([0.15, -0.25, 0.05], quat(0, 1, 0, 0))\n    path Os about z, θe hold : soft\n    solver qp\n  }}\n"
             ),

@@ -434,3 +434,32 @@ fn opt_end_states_keep_the_limit_margin() {
     assert!(default > 0.0);
     assert!(room(&end_of_retract(default)) >= default - 1e-9);
 }
+
+/// `solver MSk ..` reaches the decomposed segments: type III decomposes
+/// into MS1 and MS2, each carrying its own solver (the action's for the one
+/// not named), and naming MS3 is refused with the entry's place.
+#[test]
+fn a_solver_per_segment_reaches_the_segments() {
+    let robot = common::load("coman_right_arm");
+    let action = |solver: &str| {
+        file(&format!(
+            "  action a {{\n    goal Pw Ow = ([0.27, -0.1, 0.05], axes(f: [1, 0, 0], p: [0, 1, 0]))\n      \
+             > Os = axes(r: [0.707, -0.707, 0], l: [0, 0, -1])\n    {solver}\n  }}"
+        ))
+    };
+    let text = action("solver rrt, MS2 qp");
+    let decomposition =
+        decompose(&robot, &task(&text), &DecomposeOptions::default()).expect("type III decomposes");
+    let solvers: Vec<&str> =
+        decomposition.actions[0].segments.iter().map(|s| s.solver.name()).collect();
+    assert_eq!(solvers, ["rrt", "qp"]);
+
+    let text = action("solver MS1 qp, MS3 rrt");
+    match decompose(&robot, &task(&text), &DecomposeOptions::default()) {
+        Err(error @ DecomposeError::NoSuchSegment { segment: 2, count: 2, span, .. }) => {
+            assert_eq!(&text[span.start..span.end], "MS3 rrt");
+            assert!(error.to_string().contains("`solver MS3` names no segment"), "{error}");
+        }
+        other => panic!("expected NoSuchSegment, got {other:?}"),
+    }
+}

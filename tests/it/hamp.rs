@@ -10,7 +10,7 @@ use a2ml::language;
 use a2ml::math::{JointVector, Rotation3, UnitQuaternion, Vector3, rotation_about};
 use a2ml::metrics::pattern::similarity;
 use a2ml::metrics::{self, Analysis, MetricsOptions, Span};
-use a2ml::solve::hamp::{Handover, HampOptions, HampPlan, HandoverTarget, plan_handover};
+use a2ml::solve::hamp::{HampOptions, HampPlan, Handover, HandoverTarget, plan_handover};
 use a2ml::solve::{PlanOptions, plan};
 
 use crate::common;
@@ -25,7 +25,9 @@ fn target(robot: &Robot, start: &JointVector) -> HandoverTarget {
     let state = cpsa_state(robot, &arm_pose(robot, start)).expect("regular start");
     HandoverTarget {
         pw: state.pw + Vector3::new(0.10, -0.08, 0.11),
-        ow: Rotation3::from_matrix_unchecked(rotation_about(&Vector3::z(), 0.3) * state.ow.matrix()),
+        ow: Rotation3::from_matrix_unchecked(
+            rotation_about(&Vector3::z(), 0.3) * state.ow.matrix(),
+        ),
         swivel: Some(state.swivel + 0.35),
     }
 }
@@ -34,8 +36,9 @@ fn hamp_plan(handover: Handover) -> (Robot, HampPlan) {
     let robot = common::load("coman_right_arm");
     let start = coman_start();
     let options = HampOptions { handover, seed: 7, ..HampOptions::default() };
-    let plan = plan_handover(&robot, &start, &target(&robot, &start), &CollisionScene::new(&[]), &options)
-        .expect("plans");
+    let plan =
+        plan_handover(&robot, &start, &target(&robot, &start), &CollisionScene::new(&[]), &options)
+            .expect("plans");
     (robot, plan)
 }
 
@@ -63,7 +66,8 @@ fn a_hamp_pick_up_shows_its_planned_pattern_minimum_jerk_and_fitts_duration() {
     let times = trajectory.times();
     let speed = |k: usize| {
         let (a, b) = (&trajectory.positions()[k - 1], &trajectory.positions()[k + 1]);
-        (arm_pose(&robot, b).wrist - arm_pose(&robot, a).wrist).norm() / (times[k + 1] - times[k - 1])
+        (arm_pose(&robot, b).wrist - arm_pose(&robot, a).wrist).norm()
+            / (times[k + 1] - times[k - 1])
     };
     let (peak_frame, peak) = (1..trajectory.len() - 1)
         .map(|k| (k, speed(k)))
@@ -117,7 +121,8 @@ fn handover_task(robot: &Robot, solver: Option<&str>) -> a2ml::language::Task {
         quat(&goal.ow),
         goal.swivel.expect("given")
     );
-    language::parse(&source, Some(&common::example("inline.a2ml"))).unwrap_or_else(|d| panic!("{d}"))
+    language::parse(&source, Some(&common::example("inline.a2ml")))
+        .unwrap_or_else(|d| panic!("{d}"))
 }
 
 fn row(name: &str, a: &Analysis) -> String {
@@ -159,7 +164,8 @@ fn hamp_and_a2ml_plans_of_one_handover_scored_side_by_side() {
     // HAMP's patterns are the ones the paper selects for a pick-up; A2ML's are scored against them.
     for (analysis, exact) in [(&of_hamp, true), (&of_a2ml, false)] {
         let p = &analysis.whole.patterns;
-        let score = 0.5 * (similarity(&p.phase1.hamp, &hamp.phase1) + similarity(&p.phase2.hamp, &hamp.phase2));
+        let score = 0.5
+            * (similarity(&p.phase1.hamp, &hamp.phase1) + similarity(&p.phase2.hamp, &hamp.phase2));
         assert!((0.0..=1.0).contains(&score));
         if exact {
             assert_eq!(score, 1.0);
@@ -183,10 +189,15 @@ fn solver_hamp_plans_a_goal_action_as_a_pick_up() {
     assert!(planned.reached(), "{:?}", planned.warnings);
     let segment = &planned.segments[0];
     assert_eq!(segment.solver.name(), "hamp");
-    let travel = (goal.pw - cpsa_state(&robot, &arm_pose(&robot, &start)).expect("regular").pw).norm();
+    let travel =
+        (goal.pw - cpsa_state(&robot, &arm_pose(&robot, &start)).expect("regular").pw).norm();
     assert!((segment.duration - FittsLaw::default().duration(travel)).abs() < 1e-9);
-    let analysis =
-        metrics::analyze(&robot, &planned.trajectory, &Span::of_plan(&planned), &MetricsOptions::default());
+    let analysis = metrics::analyze(
+        &robot,
+        &planned.trajectory,
+        &Span::of_plan(&planned),
+        &MetricsOptions::default(),
+    );
     let patterns = &analysis.segments[0].patterns;
     assert_eq!(patterns.phase1.hamp.to_string(), "ΦPO");
     assert_eq!(patterns.phase2.hamp.to_string(), "ΦPO-PO");

@@ -44,6 +44,8 @@ mod malformed {
     use super::expect_error;
 
     malformed!(bad_token, 4, 31, "expected");
+    malformed!(solver_no_such_segment, 4, 20, "has 2 segments (MS1, MS2): there is no MS3");
+    malformed!(solver_not_a_segment, 5, 12, "`S1` is not a segment");
     malformed!(missing_brace, 6, 1, "expected `+Se` or `action`");
     malformed!(unterminated_string, 1, 7, "expected");
     malformed!(missing_equals, 4, 13, "expected `=` or a state variable");
@@ -392,4 +394,56 @@ mod no_panic {
             }
         }
     }
+}
+
+/// The formatter's laws on every example and every file of the malformed
+/// corpus that parses (a semantic error is no reason not to format):
+/// `fmt(fmt(x)) == fmt(x)`, `parse(fmt(x)) == parse(x)` modulo spans and
+/// layout, the same comment texts (as a multiset, since canonical order may
+/// move a statement with its comments), and no line past the width unless
+/// one piece alone is longer. A file that does not parse is refused.
+#[test]
+fn fmt_laws_over_the_examples_and_the_malformed_corpus() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut formatted = 0;
+    let mut refused = 0;
+    for folder in ["examples", "tests/malformed"] {
+        for entry in std::fs::read_dir(root.join(folder)).expect("folder") {
+            let path = entry.expect("entry").path();
+            if path.extension().and_then(|e| e.to_str()) != Some("a2ml") {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).expect("readable");
+            let Ok(tree) = parse_ast(&text, Some(&path)) else {
+                refused += 1;
+                continue;
+            };
+            formatted += 1;
+            let printed = format(&tree);
+            let again = parse_ast(&printed, Some(&path)).unwrap_or_else(|e| {
+                panic!("{}: fmt output does not parse:\n{e}\n{printed}", path.display())
+            });
+            assert_eq!(again.items, tree.items, "{}: fmt changed the meaning", path.display());
+            let texts = |file: &a2ml::language::ast::File| {
+                let mut texts: Vec<String> = file.comments.iter().map(|c| c.text.clone()).collect();
+                texts.sort();
+                texts
+            };
+            assert_eq!(texts(&again), texts(&tree), "{}: comments", path.display());
+            assert_eq!(format(&again), printed, "{}: fmt is not idempotent", path.display());
+            for line in printed.lines() {
+                let code =
+                    line.split(" #").next().unwrap_or(line).split(" //").next().unwrap_or(line);
+                let is_comment = line.trim_start().starts_with(['#', '/']);
+                let scene_row = line.contains(" = ") && !line.trim_start().starts_with("goal");
+                assert!(
+                    is_comment || scene_row || code.chars().count() <= a2ml::language::WIDTH,
+                    "{}: line too long:\n{line}",
+                    path.display()
+                );
+            }
+        }
+    }
+    assert!(formatted >= 60, "only {formatted} files formatted");
+    assert!(refused >= 5, "only {refused} files refused");
 }

@@ -259,7 +259,9 @@ fn paper_scene_with_box() -> Vec<Obstacle> {
     let mut scene = paper_spheres();
     scene.push(Obstacle {
         name: "block".to_owned(),
-        shape: Shape::Box { center: mm(20.0, 20.0, -45.0), size: mm(30.0, 30.0, 20.0),
+        shape: Shape::Box {
+            center: mm(20.0, 20.0, -45.0),
+            size: mm(30.0, 30.0, 20.0),
             rotation: Rotation3::identity(),
         },
     });

@@ -5,8 +5,8 @@ use a2ml::decompose::FittsLaw;
 use a2ml::kinematics::{CpsaState, HatState, arm_pose, hat_state, ik_hat};
 use a2ml::math::{JointVector, PI, Real, Rotation3, Vector3, rotation_about};
 use a2ml::metrics::pattern::{
-    ElementSpeeds, Hamp, PatternOptions, Primitive, connection_frequencies,
-    connection_similarity, extract, similarity,
+    ElementSpeeds, Hamp, PatternOptions, Primitive, connection_frequencies, connection_similarity,
+    extract, similarity,
 };
 use a2ml::metrics::rula::{self, RulaAngles, RulaOptions};
 
@@ -222,7 +222,10 @@ fn rula_bands_include_their_lower_bound() {
     let wrist = |deg: Real| rula::wrist_score(&posture(0.0, 0.0, 90.0, deg, 0.0), &options);
     assert_eq!([wrist(5.0), wrist(5.1), wrist(14.9), wrist(15.0)], [1, 2, 2, 3]);
     let twist = |at: Real| {
-        rula::wrist_twist_score(&RulaAngles { twist: at, ..posture(0.0, 0.0, 90.0, 0.0, 0.0) }, &options)
+        rula::wrist_twist_score(
+            &RulaAngles { twist: at, ..posture(0.0, 0.0, 90.0, 0.0, 0.0) },
+            &options,
+        )
     };
     assert_eq!([twist(0.0), twist(0.49), twist(0.5), twist(1.0)], [1, 1, 2, 2]);
 }
@@ -234,7 +237,9 @@ fn rula_bands_include_their_lower_bound() {
 fn rula_angles_read_the_posture_reached_by_ik() {
     let robot = common::load("coman_right_arm");
     let options = RulaOptions::default();
-    let start = JointVector::from_fn(|i, _| [-10.0_f64, -15.0, 45.0, -100.0, 0.0, 0.0, 0.0][i].to_radians());
+    let start = JointVector::from_fn(|i, _| {
+        [-10.0_f64, -15.0, 45.0, -100.0, 0.0, 0.0, 0.0][i].to_radians()
+    });
     let before = hat_state(&arm_pose(&robot, &start)).expect("regular");
     let (at_start, _) = rula::rula_at(&robot, &start, &options).expect("regular");
     let flexion = 60.0_f64.to_radians();
@@ -243,7 +248,11 @@ fn rula_angles_read_the_posture_reached_by_ik() {
     for l in [-Vector3::y(), Vector3::y()] {
         let frame = Rotation3::from_basis_unchecked(&[r, l, r.cross(&l)]);
         let turn = frame * before.shoulder_frame.inverse();
-        let hat = HatState { shoulder_frame: frame, elbow_angle: before.elbow_angle, ow: turn * before.ow };
+        let hat = HatState {
+            shoulder_frame: frame,
+            elbow_angle: before.elbow_angle,
+            ow: turn * before.ow,
+        };
         if let Some(q) = ik_hat(&robot, &hat, Some(&start)).ok().and_then(|s| s.first().copied()) {
             reached = Some(q);
             break;

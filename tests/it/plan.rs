@@ -228,7 +228,8 @@ fn bad_settings_and_unavailable_solvers_are_errors() {
     assert!(matches!(plan(&robot, &task, &options), Err(SolveError::InvalidRate { .. })));
     let options =
         PlanOptions { solver: Some(language::SolverChoice::Hamp), ..PlanOptions::default() };
-    let message = plan(&robot, &task, &options).expect_err("hamp plans goal segments only").to_string();
+    let message =
+        plan(&robot, &task, &options).expect_err("hamp plans goal segments only").to_string();
     assert!(message.contains("solver `hamp` is not available yet"), "{message}");
 }
 

@@ -1,12 +1,12 @@
 //! Rotated scene objects: written in a task, printed back by `fmt`, and checked for
 //! collisions against brute force in each shape's own frame.
 
-use std::path::PathBuf;
-use a2ml::collision::{CollisionModel, CollisionScene, arm_capsules, clearance, distances};
 use a2ml::collision::DistanceOptions;
+use a2ml::collision::{CollisionModel, CollisionScene, arm_capsules, clearance, distances};
 use a2ml::kinematics::arm_pose;
 use a2ml::language::{Obstacle, Shape, format, parse, parse_ast};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+use std::path::PathBuf;
 
 use a2ml::math::{Real, Rotation3, UnitQuaternion, Vector3};
 use a2ml::robot::LinkRole;
@@ -132,7 +132,9 @@ fn rotated_boxes_and_cylinders_match_brute_force() {
             let samples = 4000;
             let step = (c.b - c.a).norm() / samples as Real;
             let brute = (0..=samples)
-                .map(|i| point_distance(&shape, &(c.a + (c.b - c.a) * (i as Real / samples as Real))))
+                .map(|i| {
+                    point_distance(&shape, &(c.a + (c.b - c.a) * (i as Real / samples as Real)))
+                })
                 .fold(Real::INFINITY, Real::min)
                 - c.radius;
             let p = found
@@ -145,7 +147,12 @@ fn rotated_boxes_and_cylinders_match_brute_force() {
             // parry's GJK meets a cylinder's curved side to about 10 µm; a box's faces exactly.
             let precision = if k % 2 == 0 { 1e-6 } else { 2e-5 };
             if brute > 1e-3 {
-                assert!(p.distance <= brute + precision, "{k} {}: {} > {brute}", c.name, p.distance);
+                assert!(
+                    p.distance <= brute + precision,
+                    "{k} {}: {} > {brute}",
+                    c.name,
+                    p.distance
+                );
                 assert!(p.distance >= brute - step, "{k} {}: {} < {brute}", c.name, p.distance);
             } else {
                 assert!(p.distance < 1e-3 + step, "{k} {}: {} vs {brute}", c.name, p.distance);
@@ -156,10 +163,10 @@ fn rotated_boxes_and_cylinders_match_brute_force() {
             smallest = smallest.min(p.distance);
         }
         // The allocation-free model agrees with the general query.
-        let model = CollisionModel::new(&robot, &CollisionScene::new(&[Obstacle {
-            name: "o".into(),
-            shape,
-        }]));
+        let model = CollisionModel::new(
+            &robot,
+            &CollisionScene::new(&[Obstacle { name: "o".into(), shape }]),
+        );
         let arm_only = clearance(&model, &q);
         let empty = CollisionModel::new(&robot, &CollisionScene::new(&[]));
         let self_only = clearance(&empty, &q);

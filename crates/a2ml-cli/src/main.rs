@@ -9,6 +9,7 @@ mod batch;
 mod commands;
 mod error;
 mod output;
+mod progress;
 mod signals;
 
 use std::io::Write;

@@ -9,9 +9,9 @@ use a2ml_core::solve::compare::{ComparisonRecord, compare as compare_solvers, re
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use crate::PyRobot;
 use crate::language::{self, PyTask};
 use crate::plan::{solver_choice, task_path};
-use crate::PyRobot;
 
 /// The default solvers: A2ML's own policy and the three baselines.
 const DEFAULT_SOLVERS: [SolverChoice; 4] =
@@ -38,9 +38,7 @@ pub(crate) fn compare<'py>(
     let task = &task.get().task;
     let robot = match robot {
         Some(robot) => robot.unbind(),
-        None => {
-            Py::new(py, PyRobot::of_task(py, task)?)?
-        }
+        None => Py::new(py, PyRobot::of_task(py, task)?)?,
     };
     let robot = &robot.get().robot;
     let rows: Vec<ComparisonRecord> = py.detach(|| {

@@ -6,9 +6,9 @@
 //! [`decompose`], planning and its outputs in [`plan`]; exceptions and their
 //! mapping here.
 
+mod compare;
 mod decompose;
 mod language;
-mod compare;
 mod map;
 mod metrics;
 mod plan;

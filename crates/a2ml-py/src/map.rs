@@ -49,19 +49,21 @@ pub(crate) fn swivel_map<'py>(
         let start = start.ok_or_else(|| PyValueError::new_err("a robot's map needs `start`"))?;
         let q = JointVector::from_vec(read_array(start, "start", &[DOF])?);
         let points = points.ok_or_else(|| PyValueError::new_err("a robot's map needs `points`"))?;
-        let flat: Vec<Real> = points.extract::<Vec<Vec<Real>>>().map_err(|_| {
-            PyTypeError::new_err("points must be a sequence of [x, y, z] positions (m)")
-        })?
-        .into_iter()
-        .map(|p| {
-            if p.len() == 3 {
-                Ok(p)
-            } else {
-                Err(PyValueError::new_err("each point must have 3 coordinates"))
-            }
-        })
-        .collect::<PyResult<Vec<_>>>()?
-        .concat();
+        let flat: Vec<Real> = points
+            .extract::<Vec<Vec<Real>>>()
+            .map_err(|_| {
+                PyTypeError::new_err("points must be a sequence of [x, y, z] positions (m)")
+            })?
+            .into_iter()
+            .map(|p| {
+                if p.len() == 3 {
+                    Ok(p)
+                } else {
+                    Err(PyValueError::new_err("each point must have 3 coordinates"))
+                }
+            })
+            .collect::<PyResult<Vec<_>>>()?
+            .concat();
         let duration =
             duration.ok_or_else(|| PyValueError::new_err("a robot's map needs `duration`"))?;
         let obstacles = spheres
@@ -72,9 +74,9 @@ pub(crate) fn swivel_map<'py>(
                     name,
                     shape: Shape::Sphere { center: Vector3::new(*x, *y, *z), radius },
                 }),
-                _ => Err(PyValueError::new_err(
-                    "each sphere is (name, [x, y, z], radius > 0) in m",
-                )),
+                _ => {
+                    Err(PyValueError::new_err("each sphere is (name, [x, y, z], radius > 0) in m"))
+                }
             })
             .collect::<PyResult<Vec<_>>>()?;
         let result = py.detach(|| {
@@ -111,8 +113,8 @@ pub(crate) fn swivel_map<'py>(
         return Err(PyValueError::new_err("segment counts from 1"));
     }
     let result = py.detach(|| {
-        let robot = task.load_robot(&a2ml_core::RobotOptions::default())
-            .map_err(|e| e.to_string())?;
+        let robot =
+            task.load_robot(&a2ml_core::RobotOptions::default()).map_err(|e| e.to_string())?;
         segment_map(&robot, &task, action, segment - 1, &DecomposeOptions::default(), &options)
             .map_err(|e| e.to_string())
     });

@@ -17,7 +17,7 @@ use a2ml_core::metrics::rula::{RulaScores, table_a};
 use a2ml_core::metrics::{self, Analysis, MetricsOptions, Span, SpanMetrics};
 use a2ml_core::output::{self, ReadError, RecordedPlan};
 use a2ml_core::robot::RobotOptions;
-use a2ml_core::solve::hamp::{Handover, HampOptions, HandoverTarget, plan_handover};
+use a2ml_core::solve::hamp::{HampOptions, Handover, HandoverTarget, plan_handover};
 use a2ml_core::trajectory::Trajectory;
 use pyo3::exceptions::{PyOSError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -50,7 +50,8 @@ fn score_column<'py>(
     scores: &[Option<RulaScores>],
     pick: impl Fn(&RulaScores) -> u8,
 ) -> Bound<'py, numpy::PyArray1<Real>> {
-    let values: Vec<Real> = scores.iter().map(|s| s.map_or(Real::NAN, |s| Real::from(pick(&s)))).collect();
+    let values: Vec<Real> =
+        scores.iter().map(|s| s.map_or(Real::NAN, |s| Real::from(pick(&s)))).collect();
     to_vector(py, &values)
 }
 
@@ -70,7 +71,8 @@ fn analysis_dict<'py>(py: Python<'py>, analysis: &Analysis) -> PyResult<Dict<'py
     frames.set_item("wrist", score_column(py, &f.rula, |s| s.wrist))?;
     frames.set_item("wrist_twist", score_column(py, &f.rula, |s| s.wrist_twist))?;
     let angle = |pick: fn(&metrics::rula::RulaAngles) -> Real| {
-        let values: Vec<Real> = f.rula_angles.iter().map(|a| a.as_ref().map_or(Real::NAN, pick)).collect();
+        let values: Vec<Real> =
+            f.rula_angles.iter().map(|a| a.as_ref().map_or(Real::NAN, pick)).collect();
         to_vector(py, &values)
     };
     frames.set_item("upper_arm_flexion", angle(|a| a.upper_arm_flexion))?;
@@ -207,7 +209,12 @@ pub(crate) fn _metrics_fitts_duration(amplitude: Real) -> PyResult<Real> {
 
 /// RULA Table A.
 #[pyfunction]
-pub(crate) fn _metrics_rula_table_a(upper_arm: u8, lower_arm: u8, wrist: u8, wrist_twist: u8) -> PyResult<u8> {
+pub(crate) fn _metrics_rula_table_a(
+    upper_arm: u8,
+    lower_arm: u8,
+    wrist: u8,
+    wrist_twist: u8,
+) -> PyResult<u8> {
     let valid = (1..=6).contains(&upper_arm)
         && (1..=3).contains(&lower_arm)
         && (1..=4).contains(&wrist)
@@ -245,7 +252,8 @@ pub(crate) fn _metrics_plan_handover<'py>(
         }
     };
     let start = read_joints(start, "start")?;
-    let target = HandoverTarget { pw: read_vector3(pw, "pw")?, ow: read_rotation(ow, "ow")?, swivel };
+    let target =
+        HandoverTarget { pw: read_vector3(pw, "pw")?, ow: read_rotation(ow, "ow")?, swivel };
     let options = HampOptions { handover, seed, rate, ..HampOptions::default() };
     let robot = &robot.get().robot;
     let planned = py

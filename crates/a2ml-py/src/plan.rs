@@ -55,9 +55,7 @@ pub(crate) fn plan(
     let planned_task = seeded(&task.get().task, seed);
     let robot = match robot {
         Some(robot) => robot.unbind(),
-        None => {
-            Py::new(py, PyRobot::of_task(py, &planned_task)?)?
-        }
+        None => Py::new(py, PyRobot::of_task(py, &planned_task)?)?,
     };
     let planned = py
         .detach(|| solve::plan(&robot.get().robot, &planned_task, &options))
@@ -105,9 +103,8 @@ pub(crate) fn plan_many(
                 None => {
                     let t = &task.get().task;
                     let key = (t.robot.clone(), t.robot_base.clone(), t.robot_tip.clone());
-                    let loaded = robots
-                        .entry(key)
-                        .or_insert_with(|| Py::new(py, PyRobot::of_task(py, t)?));
+                    let loaded =
+                        robots.entry(key).or_insert_with(|| Py::new(py, PyRobot::of_task(py, t)?));
                     match loaded {
                         Ok(robot) => robot.clone_ref(py),
                         Err(e) => return Err(e.clone_ref(py)),

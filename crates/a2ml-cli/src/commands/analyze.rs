@@ -124,7 +124,8 @@ fn row(table: &mut Table, m: &SpanMetrics) {
     let [rula_mean, rula_max] = summary(m.rula);
     let [sum_mean, sum_max] = summary(m.rula_sum);
     let p = &m.patterns;
-    let hamp = |h: &metrics::pattern::Hamp| if h.is_empty() { "-".to_owned() } else { h.to_string() };
+    let hamp =
+        |h: &metrics::pattern::Hamp| if h.is_empty() { "-".to_owned() } else { h.to_string() };
     table.row(
         m.span.label.clone(),
         [
@@ -149,8 +150,22 @@ fn row(table: &mut Table, m: &SpanMetrics) {
 
 fn text(report: &Report<'_>) -> String {
     let mut table = Table::with_header([
-        "span", "start (s)", "T (s)", "Fitts (s)", "×Fitts", "HAMP 1", "HAMP 2", "R_Φ",
-        "RULA A", "max", "UA+LA+W", "max", "peak t/T", "symmetry", "peaks", "NJ wrist",
+        "span",
+        "start (s)",
+        "T (s)",
+        "Fitts (s)",
+        "×Fitts",
+        "HAMP 1",
+        "HAMP 2",
+        "R_Φ",
+        "RULA A",
+        "max",
+        "UA+LA+W",
+        "max",
+        "peak t/T",
+        "symmetry",
+        "peaks",
+        "NJ wrist",
     ])
     .left_aligned([5, 6]);
     for segment in report.segments {

@@ -13,11 +13,11 @@ use serde::Serialize;
 
 use a2ml_core::Robot;
 use a2ml_core::decompose::{
-    self, DecomposeOptions, Decomposition, OptReport, PlannedAction, PlannedSegment,
+    self, DecomposeError, DecomposeOptions, Decomposition, OptReport, PlannedAction, PlannedSegment,
 };
 use a2ml_core::language::{
-    ActionBody, Axis, BodyAxis, Goal, GoalConstraint, PathConstraint, PathFeature, Primitive,
-    PrimitiveConstraint, Space, Target, Task, Variable,
+    self as language, ActionBody, Axis, BodyAxis, Goal, GoalConstraint, PathConstraint,
+    PathFeature, Primitive, PrimitiveConstraint, Space, Target, Task, Variable,
 };
 use a2ml_core::math::{DOF, JointVector, Real, Rotation3, Vector3};
 
@@ -61,13 +61,28 @@ pub struct ExplainArgs {
 /// [`CliError::Input`] when the task is invalid (its diagnostics go to
 /// stderr first), the robot is unusable, or the decomposition fails.
 pub fn run(args: &ExplainArgs) -> Result<(), CliError> {
-    let (task, _) = super::load_task(&args.file, &args.limits.limits())?;
+    let (task, source) = super::load_task(&args.file, &args.limits.limits())?;
     let options = args.arm.options(task.robot_base.as_deref(), task.robot_tip.as_deref())?;
     let robot = Robot::from_urdf_file_with(&task.robot, &options)?;
     let decomposition = decompose::decompose(&robot, &task, &DecomposeOptions::default())
-        .map_err(|e| CliError::Input(format!("{}: {e}", args.file.display())))?;
+        .map_err(|e| decomposition_error(&args.file, &source, &e))?;
     let report = ExplainReport::new(&args.file, &robot, &task, &decomposition);
     output::emit(&report, args.json, &report.warnings, || report.to_text())
+}
+
+/// A decomposition that failed: located in the task file, with the line and
+/// a caret, when the error points at what was written.
+fn decomposition_error(file: &Path, source: &str, error: &DecomposeError) -> CliError {
+    if let DecomposeError::NoSuchSegment { span, .. } = error {
+        let diagnostics = language::Diagnostics {
+            path: Some(file.display().to_string()),
+            source: source.to_owned(),
+            items: vec![language::Diagnostic::new(*span, error.to_string())],
+            omitted: 0,
+        };
+        output::report(&diagnostics.to_string());
+    }
+    CliError::Input(format!("{}: {error}", file.display()))
 }
 
 /// Everything `a2ml explain` reports; its field names are the JSON keys.

@@ -4,7 +4,6 @@
 //! one row per segment, and a line of totals; stderr gets the warnings and,
 //! on a terminal, a progress bar while planning takes a while.
 
-use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -25,9 +24,6 @@ use crate::signals::Temporaries;
 
 /// Decimals for durations (s).
 const SECONDS: usize = 3;
-
-/// Planning shorter than this shows no progress bar: it would only flicker.
-const PROGRESS_DELAY: Duration = Duration::from_millis(300);
 
 /// Arguments of `a2ml plan`.
 #[derive(Debug, Args)]
@@ -174,7 +170,7 @@ fn run_one(args: &PlanArgs, file: &Path, temporaries: &Temporaries) -> Result<()
     let planning = Planning::load(args, file, &outputs, &[])?;
 
     let started = Instant::now();
-    let mut bar = ProgressBar::new(started);
+    let mut bar = crate::progress::PlanBar::new(started);
     let result = planning.plan(&mut |p| bar.update(p));
     bar.clear();
     let plan = result?;
@@ -183,7 +179,7 @@ fn run_one(args: &PlanArgs, file: &Path, temporaries: &Temporaries) -> Result<()
     for warning in &plan.warnings {
         output::warn(warning);
     }
-    let tolerance = planning.options.qp.tolerance;
+    let tolerance = planning.options.tolerance;
     output::print(&summary(file, &planning.robot, &plan, &tolerance, planning_time))?;
     planning.write(temporaries, &outputs, &plan)?;
     for (_, path) in &outputs {
@@ -545,49 +541,6 @@ fn worst_rates(plan: &Plan) -> String {
 fn short(x: Real) -> String {
     let text = num(x, 3);
     text.trim_end_matches('0').trim_end_matches('.').to_owned()
-}
-
-/// A one-line progress bar on stderr, drawn only on a terminal and only once
-/// planning has taken longer than [`PROGRESS_DELAY`].
-struct ProgressBar {
-    started: Instant,
-    terminal: bool,
-    drawn: bool,
-}
-
-impl ProgressBar {
-    const WIDTH: usize = 24;
-
-    fn new(started: Instant) -> Self {
-        Self { started, terminal: std::io::stderr().is_terminal(), drawn: false }
-    }
-
-    fn update(&mut self, p: &Progress) {
-        if !self.terminal || self.started.elapsed() < PROGRESS_DELAY || p.total == 0 {
-            return;
-        }
-        let filled = Self::WIDTH * p.done.min(p.total) / p.total;
-        let line = format!(
-            "\r\x1b[2Kplanning [{}{}] {}/{} segments, `{}` done",
-            "#".repeat(filled),
-            "-".repeat(Self::WIDTH - filled),
-            p.done,
-            p.total,
-            p.action
-        );
-        let mut stderr = std::io::stderr().lock();
-        // A progress bar that cannot be drawn is no reason to stop planning.
-        let _ = stderr.write_all(line.as_bytes()).and_then(|()| stderr.flush());
-        self.drawn = true;
-    }
-
-    /// Erases the bar, so that what follows starts on a clean line.
-    fn clear(&mut self) {
-        if self.drawn {
-            let _ = std::io::stderr().write_all(b"\r\x1b[2K");
-            self.drawn = false;
-        }
-    }
 }
 
 #[cfg(test)]

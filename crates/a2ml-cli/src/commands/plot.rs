@@ -7,11 +7,11 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 
-use a2ml_core::{Robot, RobotOptions};
 use a2ml_core::language::Task;
 use a2ml_core::output::plot::{PlotData, PlotKind, write_plot, write_plot_data};
 use a2ml_core::output::{RecordedPlan, read_mcap};
 use a2ml_core::solve::{self, Plan, PlanOptions};
+use a2ml_core::{Robot, RobotOptions};
 
 use crate::error::CliError;
 use crate::output;

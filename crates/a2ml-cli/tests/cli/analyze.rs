@@ -5,10 +5,10 @@ use std::path::Path;
 
 use serde_json::Value;
 
+use a2ml_core::Robot;
 use a2ml_core::language;
 use a2ml_core::metrics::{self, MetricsOptions, Span};
 use a2ml_core::solve::{PlanOptions, plan};
-use a2ml_core::Robot;
 
 use crate::{a2ml, example_path, robot_path, scratch, stderr, stdout};
 
@@ -70,8 +70,12 @@ fn every_example_analyzes_from_mcap_and_csv_as_the_library_does() {
             continue;
         };
         analysed += 1;
-        let expected =
-            metrics::analyze(&robot, &fresh.trajectory, &Span::of_plan(&fresh), &MetricsOptions::default());
+        let expected = metrics::analyze(
+            &robot,
+            &fresh.trajectory,
+            &Span::of_plan(&fresh),
+            &MetricsOptions::default(),
+        );
 
         assert!(matches!(planned.status.code(), Some(0 | 3)), "{name}: {}", stderr(&planned));
 

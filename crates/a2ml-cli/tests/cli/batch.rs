@@ -134,13 +134,7 @@ fn a_missing_task_file_fails_alone_and_the_batch_exits_1() {
     let task = reach_task(&dir, "reach", 0.24);
     let missing = dir.join("nowhere.a2ml");
     let mcap = dir.join("{stem}.mcap").to_string_lossy().into_owned();
-    let output = a2ml(&[
-        "plan",
-        &missing.to_string_lossy(),
-        &task.to_string_lossy(),
-        "-o",
-        &mcap,
-    ]);
+    let output = a2ml(&["plan", &missing.to_string_lossy(), &task.to_string_lossy(), "-o", &mcap]);
     assert_eq!(output.status.code(), Some(1), "an unreadable file is the worst");
     let text = stdout(&output);
     assert!(text.starts_with(&format!("failed  {}  exit 1: ", missing.display())), "{text}");

@@ -217,3 +217,59 @@ fn fmt_write_through_a_link_keeps_the_link_and_permissions() {
     let mode = fs::metadata(&target).expect("target").permissions().mode();
     assert_eq!(mode & 0o777, 0o640);
 }
+
+/// The `.a2ml` files under `dir`, at any depth, in order.
+fn task_files(dir: &std::path::Path) -> Vec<String> {
+    let mut found = Vec::new();
+    for entry in fs::read_dir(dir).expect("readable folder") {
+        let path = entry.expect("entry").path();
+        if path.is_dir() {
+            found.extend(task_files(&path));
+        } else if path.extension().is_some_and(|e| e == "a2ml") {
+            found.push(path.display().to_string());
+        }
+    }
+    found.sort();
+    found
+}
+
+/// Every shipped example is in canonical form: `a2ml fmt --check
+/// examples/**/*.a2ml` exits 0 and says nothing.
+#[test]
+fn every_example_is_canonical() {
+    let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let files = task_files(&examples);
+    assert!(files.len() >= 20, "only {} examples", files.len());
+    let mut args = vec!["fmt", "--check"];
+    args.extend(files.iter().map(String::as_str));
+    let output = a2ml(&args);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+    assert!(stderr(&output).is_empty() && stdout(&output).is_empty());
+}
+
+/// A file with a syntax error is refused with the located diagnostic and
+/// left as it was, under `--write` too.
+#[test]
+fn fmt_refuses_a_syntax_error_and_leaves_the_file() {
+    let malformed = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/malformed");
+    let dir = scratch("language", "fmt_refuses");
+    let mut refused = 0;
+    for source in task_files(&malformed) {
+        let text = read(&source);
+        if a2ml_core::language::parse_ast(&text, None).is_ok() {
+            continue;
+        }
+        refused += 1;
+        let name = std::path::Path::new(&source).file_name().expect("a file name");
+        let path = dir.join(name).display().to_string();
+        fs::write(&path, &text).expect("writable");
+        for mode in ["--write", "--check"] {
+            let output = a2ml(&["fmt", mode, &path]);
+            assert_eq!(output.status.code(), Some(2), "{source} {mode}");
+            let err = stderr(&output);
+            assert!(err.contains(&format!("--> {path}:")) && err.contains('^'), "{source}: {err}");
+            assert_eq!(read(&path), text, "{source}: {mode} changed a file it refused");
+        }
+    }
+    assert!(refused >= 5, "only {refused} files of the corpus have syntax errors");
+}

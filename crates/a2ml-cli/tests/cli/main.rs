@@ -3,14 +3,15 @@
 
 mod analyze;
 mod batch;
-mod compare;
 mod bounds;
+mod compare;
 mod examples;
 mod explain;
 mod language;
 mod outputs;
 mod plan;
 mod plot;
+mod progress;
 mod robot;
 
 use std::fs;

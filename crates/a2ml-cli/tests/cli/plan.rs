@@ -201,7 +201,9 @@ fn unavailable_solver_exits_2() {
 
     let output = a2ml(&["plan", &task, "--solver", "fast"]);
     assert_eq!(output.status.code(), Some(2));
-    assert!(stderr(&output).contains("[possible values: auto, qp, rrt, map, gpm, clik, pmp, hamp]"));
+    assert!(
+        stderr(&output).contains("[possible values: auto, qp, rrt, map, gpm, clik, pmp, hamp]")
+    );
 }
 
 #[test]

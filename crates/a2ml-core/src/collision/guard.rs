@@ -78,7 +78,10 @@ pub fn check_shapes(robot: &Robot, obstacles: &[Obstacle]) -> Result<(), ShapeEr
             Shape::Sphere { center, radius } => within(center) && size_ok(*radius, true),
             Shape::Capsule { a, b, radius } => within(a) && within(b) && size_ok(*radius, true),
             Shape::Cylinder { center, radius, height, rotation } => {
-                within(center) && size_ok(*radius, true) && size_ok(*height, true) && proper(rotation)
+                within(center)
+                    && size_ok(*radius, true)
+                    && size_ok(*height, true)
+                    && proper(rotation)
             }
         };
         if !ok {

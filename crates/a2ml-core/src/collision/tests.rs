@@ -43,7 +43,14 @@ fn capsule_sphere() {
 fn capsule_box_corner() {
     // The box spans [0.5, 1.5]² × [1.5, 2.5]; its corner (0.5, 0.5, 1.5) is
     // closest to the segment end (0, 0, 1).
-    let p = query(&link(), Shape::Box { center: v(1.0, 1.0, 2.0), size: v(1.0, 1.0, 1.0), rotation: Rotation3::identity() });
+    let p = query(
+        &link(),
+        Shape::Box {
+            center: v(1.0, 1.0, 2.0),
+            size: v(1.0, 1.0, 1.0),
+            rotation: Rotation3::identity(),
+        },
+    );
     let gap = 0.75_f64.sqrt();
     assert!((p.distance - (gap - 0.1)).abs() < TOL, "{p:?}");
     assert_close(&p.on_obstacle, &v(0.5, 0.5, 1.5));
@@ -55,7 +62,14 @@ fn capsule_box_corner() {
 
 #[test]
 fn capsule_box_face() {
-    let p = query(&link(), Shape::Box { center: v(1.0, 0.0, 0.5), size: v(0.4, 2.0, 2.0), rotation: Rotation3::identity() });
+    let p = query(
+        &link(),
+        Shape::Box {
+            center: v(1.0, 0.0, 0.5),
+            size: v(0.4, 2.0, 2.0),
+            rotation: Rotation3::identity(),
+        },
+    );
     assert!((p.distance - 0.7).abs() < TOL, "{p:?}");
     assert_close(&p.normal, &v(-1.0, 0.0, 0.0));
     assert!((p.on_link.x - 0.1).abs() < TOL && (p.on_obstacle.x - 0.8).abs() < TOL);
@@ -76,12 +90,15 @@ fn capsule_capsule_skew() {
 #[test]
 fn cylinder_is_vertical() {
     // Lying along y, this cylinder's underside would be at z = 1.9, not 1.5.
-    let p = query(&link(), Shape::Cylinder {
+    let p = query(
+        &link(),
+        Shape::Cylinder {
             center: v(0.0, 0.0, 2.0),
             radius: 0.1,
             height: 1.0,
             rotation: Rotation3::identity(),
-        });
+        },
+    );
     assert!((p.distance - 0.4).abs() < TOL, "{p:?}");
     assert_close(&p.on_link, &v(0.0, 0.0, 1.1));
     assert_close(&p.normal, &v(0.0, 0.0, -1.0));
@@ -92,7 +109,10 @@ fn cylinder_is_vertical() {
 #[test]
 fn capsule_cylinder_side() {
     let center = v(1.0, 1.0, 0.5);
-    let p = query(&link(), Shape::Cylinder { center, radius: 0.3, height: 0.4, rotation: Rotation3::identity() });
+    let p = query(
+        &link(),
+        Shape::Cylinder { center, radius: 0.3, height: 0.4, rotation: Rotation3::identity() },
+    );
     assert!((p.distance - (2.0_f64.sqrt() - 0.4)).abs() < TOL, "{p:?}");
     assert_close(&p.normal, &(-v(1.0, 1.0, 0.0) / 2.0_f64.sqrt()));
     assert!(((p.on_obstacle - center).xy().norm() - 0.3).abs() < TOL);
@@ -138,7 +158,14 @@ fn penetration_is_negative() {
     assert_close(&p.normal, &v(-1.0, 0.0, 0.0));
 
     // The segment lies inside the box, 0.05 from its -x face.
-    let p = query(&link(), Shape::Box { center: v(0.2, 0.0, 0.5), size: v(0.5, 4.0, 4.0), rotation: Rotation3::identity() });
+    let p = query(
+        &link(),
+        Shape::Box {
+            center: v(0.2, 0.0, 0.5),
+            size: v(0.5, 4.0, 4.0),
+            rotation: Rotation3::identity(),
+        },
+    );
     assert!((p.distance + 0.15).abs() < 1e-9, "{p:?}");
     assert_close(&p.normal, &v(-1.0, 0.0, 0.0));
     assert_consistent(&p);

@@ -200,8 +200,9 @@ impl Planner<'_> {
         &self.task.actions[self.index].name
     }
 
-    fn solver(&self) -> SolverChoice {
-        self.task.actions[self.index].solver.unwrap_or(self.task.settings.solver)
+    /// The solver of the action's segment `k`: its own, the action's, else the task's.
+    fn solver(&self, k: usize) -> SolverChoice {
+        self.task.actions[self.index].solver_of(k).unwrap_or(self.task.settings.solver)
     }
 
     fn state(&self, q: &JointVector, segment: usize) -> Result<ArmState, DecomposeError> {
@@ -239,6 +240,14 @@ impl Planner<'_> {
                 (Some(c), self.fit_duration(segments, *duration))
             }
         };
+        if let Some(chosen) = action.segment_solvers.iter().find(|s| s.segment >= segments.len()) {
+            return Err(DecomposeError::NoSuchSegment {
+                action: action.name.clone(),
+                segment: chosen.segment,
+                count: segments.len(),
+                span: chosen.span,
+            });
+        }
         Ok(PlannedAction {
             index: self.index,
             name: action.name.clone(),
@@ -458,7 +467,7 @@ impl Planner<'_> {
             pattern: segment_pattern(&primitives).unwrap_or(SegmentPattern::Path),
             duration,
             duration_raised,
-            solver: self.solver(),
+            solver: self.solver(k),
             primitives,
             relaxed,
             start: q,

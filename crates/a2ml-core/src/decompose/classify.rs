@@ -386,6 +386,7 @@ mod tests {
             del: Vec::new(),
             contact: Vec::new(),
             solver: None,
+            segment_solvers: Vec::new(),
             body: ActionBody::Constraints { goal, path, duration: None },
             span: Span::default(),
         }

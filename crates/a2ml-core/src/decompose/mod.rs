@@ -91,6 +91,24 @@ pub enum DecomposeError {
         /// Why.
         reason: String,
     },
+    /// A `solver MSk ..` entry names a segment the action does not decompose into.
+    #[error(
+        "action `{action}`: `solver MS{}` names no segment: the action decomposes into {count} \
+         segment{} (MS1{})",
+        segment + 1,
+        if *count == 1 { "" } else { "s" },
+        if *count > 1 { format!("..MS{count}") } else { String::new() }
+    )]
+    NoSuchSegment {
+        /// The action.
+        action: String,
+        /// The segment named (0-based).
+        segment: usize,
+        /// How many segments the action has.
+        count: usize,
+        /// Where the entry was written in the task file.
+        span: crate::language::ast::Span,
+    },
     /// A segment's goal cannot be reached within the joint limits.
     #[error("action `{action}`, segment {}: {reason}", segment + 1)]
     Unreachable {

@@ -290,6 +290,7 @@ mod tests {
                     del: strings(del),
                     contact: Vec::new(),
                     solver: None,
+                    segment_solvers: Vec::new(),
                     body: ActionBody::Constraints { goal: None, path: None, duration: None },
                     span: Span::default(),
                 })

@@ -108,6 +108,24 @@ pub struct File {
     /// Every comment in source order; [`super::format()`] puts each back
     /// beside the node it was written with.
     pub comments: Vec<Comment>,
+    /// Where the blank lines stand, which the formatter keeps.
+    #[serde(skip)]
+    pub layout: Layout,
+}
+
+/// What a text's layout says that the formatter keeps: its blank lines.
+///
+/// Layout takes no part in equality, as spans do not.
+#[derive(Debug, Clone, Default)]
+pub struct Layout {
+    /// The first byte of each line holding nothing but whitespace, in order.
+    pub blank_lines: Vec<usize>,
+}
+
+impl PartialEq for Layout {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 /// A `#` or `//` comment, which runs to the end of its line.
@@ -122,6 +140,9 @@ pub struct Comment {
     pub own_line: bool,
     /// One past the last byte of the code before it, 0 if there is none.
     pub code_before: usize,
+    /// The first byte of the code after it (past other comments), the
+    /// text's length if there is none.
+    pub code_after: usize,
     /// The text.
     pub span: Span,
 }
@@ -333,13 +354,35 @@ pub struct Action {
     /// `contact` statements: obstacles the arm may touch.
     pub contact: Vec<Facts>,
     /// `solver` statements.
-    pub solver: Vec<Name>,
+    pub solver: Vec<SolverStatement>,
     /// Constraints or explicit segments.
     pub body: ActionBody,
+    /// `+Se` is written before it (actions run in sequence either way).
+    pub sequential: bool,
     /// The action's name.
     pub span: Span,
     /// The braces and what is between them.
     pub braces: Span,
+}
+
+/// `solver qp` or `solver MS1 rrt, MS2 qp`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SolverStatement {
+    /// The entries in written order.
+    pub entries: Vec<SolverEntry>,
+    /// The `solver` keyword.
+    pub span: Span,
+}
+
+/// One entry of a `solver` statement: `rrt`, or `MS1 rrt` for one segment.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SolverEntry {
+    /// The segment, `MS1` for the action's first; none for the whole action.
+    pub segment: Option<Name>,
+    /// The solver's name.
+    pub solver: Name,
+    /// The whole entry.
+    pub span: Span,
 }
 
 /// The two forms of an action.

@@ -3,46 +3,58 @@
 //! The law: for every text that parses, `parse_ast(format(parse_ast(text)))`
 //! equals `parse_ast(text)`, comments included, and formatting is
 //! idempotent. What the tree does not keep is printed one fixed way: `>` for
-//! priority, no `+Se`, statements of an action in the order pre, add, del,
-//! contact, goal, path, duration, solver. Comments go back beside the line of the
-//! node they were written with, and move with it: a statement that canonical
+//! priority, `+Se` on the line of the action it precedes, statements of an
+//! action in the order pre, add, del, contact, goal, path, duration, solver.
+//! Comments go back beside the line of the node they were written with, and move with it: a statement that canonical
 //! order moves past another takes its comments along, which is the one way
 //! the comments' order can change.
 
 use std::collections::BTreeMap;
 
 use super::ast::{
-    Action, ActionBody, Combine, Comment, Facts, Feature, File, Goal, GoalTerm, Item, Name,
-    Obstacle, Orientation, Path, Primitive, PrimitiveConstraint, Quantity, Scene, Segment, Setting,
-    SettingValue, Settings, Shape, Span, Start, Task, Value, Vector,
+    Action, ActionBody, Combine, Comment, Facts, Feature, File, Goal, Item, Name, Obstacle,
+    Orientation, Path, Primitive, PrimitiveConstraint, Quantity, Scene, Segment, Setting,
+    SettingValue, Settings, Shape, SolverStatement, Span, Start, Task, Value, Vector,
 };
 use crate::math::Real;
 
 /// Spaces per indentation level.
 const INDENT: usize = 2;
 
+/// The columns a statement may fill before it is broken over lines.
+pub const WIDTH: usize = 100;
+
 /// Prints a syntax tree in the canonical layout: two-space indentation, one
-/// statement per line, a blank line between blocks, scene obstacles aligned
-/// in columns, numbers in their shortest form that reads back to the same
-/// `f64`, units and names as written.
+/// statement per line, a blank line between blocks and where the source
+/// had one or more (never two, none after a `{` or before a `}`), scene
+/// obstacles aligned in columns, numbers in their shortest form that reads
+/// back to the same `f64`, units and names as written.
+///
+/// A statement longer than [`WIDTH`] columns is broken: a goal before `>`,
+/// then after each comma of its value lists; a path and a fact list after
+/// each comma; a `start` state before each variable; continuation lines
+/// indented two levels more. A segment too long, or holding a comment,
+/// puts its primitives inside its braces on a line of their own, then one
+/// primitive a line. A statement that holds a comment is broken at every
+/// place, so that each comment stays at the end of the line it followed.
 ///
 /// Comments come back beside the lines of their nodes. One on a line of
 /// its own stays on a line of its own, at the indentation of the first node
 /// that starts after it and just before it; one after code goes at the end
 /// of the line that prints that code, one space after it. A line takes one
-/// comment at its end: more after it, and those written inside a statement
-/// printed on one line (a segment, a `path` over several lines), follow it
-/// on lines of their own. A comment after a node's first words (its
-/// keyword, a `+Tr`, or a `+Se` before an action) follows the node's line.
-/// Comments after a block's last node go before its closing brace, those
-/// after the last item at the end.
+/// comment at its end: more after it, and those inside a line that cannot
+/// be broken (a block's head, a value), follow it on lines of their own. A
+/// comment after a node's first words (its keyword, a `+Tr`, or a `+Se`
+/// before an action) on the same line follows the node's line. Comments
+/// after a block's last node go before its closing brace, those after the
+/// last item at the end.
 pub fn format(file: &File) -> String {
     // A first pass learns which node each printed line stands for; the
     // comments are placed against those lines, then printed in a second.
-    let mut layout = Printer::default();
+    let mut layout = Printer::new(file, Placement::default());
     layout.file(file);
     let comments = Placement::new(&file.comments, layout.anchors);
-    let mut printer = Printer { comments, ..Printer::default() };
+    let mut printer = Printer::new(file, comments);
     printer.file(file);
     printer.finish()
 }
@@ -93,6 +105,9 @@ impl<'a> Placement<'a> {
     fn new(comments: &'a [Comment], mut anchors: Vec<Anchor>) -> Self {
         anchors.sort_by_key(|a| a.start);
         let mut placement = Self::default();
+        // The line a comment after its first words went after: the comments
+        // on lines of their own before that line follow it too, in order.
+        let mut after_first_words: Option<usize> = None;
         for comment in comments {
             let at = comment.span.start;
             let first_after = anchors.partition_point(|a| a.start < at);
@@ -102,12 +117,16 @@ impl<'a> Placement<'a> {
             let (list, anchor) = if previous.is_some_and(|a| at < a.end) {
                 // Inside a line's text: after that line.
                 (&mut placement.after, previous)
+            } else if comment.own_line {
+                match next {
+                    Some(a) if after_first_words == Some(a.start) => (&mut placement.after, next),
+                    _ => (&mut placement.before, next),
+                }
             } else if comment.code_before > previous_end {
                 // After the first words of the next line, such as a keyword
                 // or `+Tr`, which its anchor does not cover.
+                after_first_words = next.map(|a| a.start);
                 (&mut placement.after, next)
-            } else if comment.own_line {
-                (&mut placement.before, next)
             } else {
                 (&mut placement.after, previous)
             };
@@ -120,20 +139,51 @@ impl<'a> Placement<'a> {
     }
 }
 
-/// Lines with indentation and the comments that go between them.
-#[derive(Default)]
+/// Lines with indentation and the comments and blank lines that go between them.
 struct Printer<'a> {
     out: String,
     depth: usize,
+    /// Every comment of the file, for the statements that hold one.
+    all_comments: &'a [Comment],
+    /// The source's blank lines ([`super::ast::Layout`]).
+    blank_lines: &'a [usize],
     /// The printed lines' nodes, in print order.
     anchors: Vec<Anchor>,
     /// The comments still to print.
     comments: Placement<'a>,
     /// Comments due on lines of their own before the next line.
     pending: Vec<&'a Comment>,
+    /// One past the last source byte printed so far.
+    last_end: usize,
+    /// One past the last source byte of the lines printed so far, comments
+    /// left out (the same in both passes).
+    anchor_end: usize,
+    /// A blank line is due before the next line, whatever the source had.
+    want_blank: bool,
+    /// The last line written opens a block, so no blank line follows it.
+    at_open: bool,
+    /// The next lines continue a statement, so no blank line goes between them.
+    continuing: bool,
 }
 
 impl<'a> Printer<'a> {
+    fn new(file: &'a File, comments: Placement<'a>) -> Self {
+        Self {
+            out: String::new(),
+            depth: 0,
+            all_comments: &file.comments,
+            blank_lines: &file.layout.blank_lines,
+            anchors: Vec::new(),
+            comments,
+            pending: Vec::new(),
+            last_end: 0,
+            anchor_end: 0,
+            want_blank: false,
+            at_open: false,
+            continuing: false,
+        }
+    }
+
     fn file(&mut self, file: &File) {
         let one_liner = |item: &Item| matches!(item, Item::Robot(_) | Item::Start(_));
         let mut previous: Option<&Item> = None;
@@ -146,21 +196,23 @@ impl<'a> Printer<'a> {
                 Item::Robot(line) => {
                     // The span is the last string's text; its closing quote follows.
                     let last = line.tip.as_ref().or(line.base.as_ref()).unwrap_or(&line.path);
-                    let quoted = Span { start: line.path.span.start, end: last.span.end + 1 };
                     let mut text = format!("robot {}", string(&line.path));
                     for (word, link) in [("base", &line.base), ("tip", &line.tip)] {
                         if let Some(link) = link {
                             text += &format!(" {word} {}", string(link));
                         }
                     }
-                    self.line(Anchor::statement(quoted, quoted), &text);
+                    self.line(
+                        Anchor { start: line.path.span.start, end: last.span.end + 1 },
+                        &text,
+                    );
                 }
                 Item::Start(start) => {
-                    let span = match start {
-                        Start::Joints(q) => q.span,
-                        Start::State { span, .. } => *span,
+                    let end = match start {
+                        Start::Joints(q) => q.span.end,
+                        Start::State { span, .. } => span.end,
                     };
-                    self.line(Anchor::statement(span, span), &self::start(start));
+                    self.statement(start_pieces(start), end);
                 }
                 Item::Scene(scene) => self.scene(scene),
                 Item::Settings(settings) => self.settings(settings),
@@ -184,6 +236,27 @@ impl<'a> Printer<'a> {
         self.out
     }
 
+    /// Whether the source has a blank line between the last text printed
+    /// and `start`.
+    fn blank_in_source(&self, start: usize) -> bool {
+        let first = self.blank_lines.partition_point(|&b| b < self.last_end);
+        self.blank_lines.get(first).is_some_and(|&b| b < start)
+    }
+
+    /// Writes the blank line due before source text from `start` to `end`,
+    /// about to be printed: one if the canonical layout wants it or the
+    /// source has one there (unless `kept` is false), never two, none at
+    /// the start or right after a `{`.
+    fn separate(&mut self, start: usize, end: usize, kept: bool) {
+        let from_source = kept && !self.continuing && self.blank_in_source(start);
+        if (self.want_blank || from_source) && !self.out.is_empty() && !self.at_open {
+            self.out.push('\n');
+        }
+        self.want_blank = false;
+        self.at_open = false;
+        self.last_end = self.last_end.max(end);
+    }
+
     /// Writes `text` as one line at `depth`.
     fn write(&mut self, depth: usize, text: &str) {
         self.out.push_str(&" ".repeat(depth * INDENT));
@@ -194,17 +267,21 @@ impl<'a> Printer<'a> {
     /// Writes the pending comments, one a line, at `depth`.
     fn own_lines(&mut self, depth: usize) {
         for comment in std::mem::take(&mut self.pending) {
+            self.separate(comment.span.start, comment.span.end, true);
             self.write(depth, &comment.text);
         }
     }
 
-    /// Records the line of `anchor`, about to be written, and writes the
-    /// comments due before it at `depth`.
-    fn comments_before(&mut self, anchor: Anchor, depth: usize) {
+    /// Records the line of `anchor`, about to be written, writes the
+    /// comments due before it at `depth` and the blank line due before it
+    /// (a source blank line only if `kept`).
+    fn comments_before(&mut self, anchor: Anchor, depth: usize, kept: bool) {
         self.anchors.push(anchor);
+        self.anchor_end = self.anchor_end.max(anchor.end);
         let before = self.comments.before.remove(&anchor.start).unwrap_or_default();
         self.pending.extend(before);
         self.own_lines(depth);
+        self.separate(anchor.start, anchor.end, kept);
     }
 
     /// Puts the first comment after the line of `anchor`, just written, at
@@ -218,6 +295,7 @@ impl<'a> Printer<'a> {
                 self.out.push(' ');
                 self.out.push_str(&first.text);
                 self.out.push('\n');
+                self.last_end = self.last_end.max(first.span.end);
             }
             Some(first) => self.pending.push(first),
             None => {}
@@ -225,19 +303,79 @@ impl<'a> Printer<'a> {
         self.pending.extend(after);
     }
 
-    /// Writes one statement at the current depth, with its comments. A `\n`
-    /// inside `text` (see [`gap`]) continues the statement on a line
-    /// indented two levels more.
+    /// Writes a statement of one piece.
     fn line(&mut self, anchor: Anchor, text: &str) {
-        self.comments_before(anchor, self.depth);
-        for (i, part) in text.split('\n').enumerate() {
-            self.write(if i == 0 { self.depth } else { self.depth + 2 }, part);
+        let piece = Piece::first(text.to_owned(), anchor.start);
+        self.statement(vec![piece], anchor.end);
+    }
+
+    /// Writes a statement made of `pieces`, whose source ends at `end`: on
+    /// one line if it fits in [`WIDTH`] columns and holds no comment, else
+    /// broken before the pieces of the fewest levels that make it fit (all
+    /// levels when it holds a comment, so that each comment stays on the
+    /// line of the piece it follows). A `\n` inside a piece (see [`gap`])
+    /// continues it on a line indented two levels more.
+    fn statement(&mut self, pieces: Vec<Piece>, end: usize) {
+        let deepest = pieces.iter().map(|p| p.level).max().unwrap_or(0);
+        let needed = self.level_for_comments(&pieces);
+        let level = (needed..=deepest).find(|&level| self.fits(&pieces, level)).unwrap_or(deepest);
+        let lines = lines(&pieces, level);
+        for (i, line) in lines.iter().enumerate() {
+            let first = &pieces[line.start];
+            let line_end = lines.get(i + 1).map_or(end, |next| pieces[next.start].start);
+            let anchor = Anchor { start: first.start, end: line_end.max(first.start) };
+            let depth = self.depth + first.indent;
+            self.continuing = i > 0;
+            // Comments before a closing brace belong inside its block.
+            let comment_depth = if first.closes { depth + 1 } else { depth };
+            self.comments_before(anchor, comment_depth, !first.closes);
+            let text = joined(&pieces[line.clone()]);
+            for (j, part) in text.split('\n').enumerate() {
+                self.write(if j == 0 { depth } else { depth + 2 }, part);
+            }
+            self.comments_after(anchor);
         }
-        self.comments_after(anchor);
+        self.continuing = false;
+    }
+
+    /// The level a statement must be broken at so that each comment it
+    /// holds ends the line of the piece it follows: one before the last
+    /// piece (one in the last goes after it), or one after the first words
+    /// of its line, which goes at the end of its first line.
+    fn level_for_comments(&self, pieces: &[Piece]) -> u8 {
+        let (Some(first), Some(last)) = (pieces.first(), pieces.last()) else { return 0 };
+        let from = self.all_comments.partition_point(|c| c.span.start < self.anchor_end);
+        let inside = self.all_comments[from..].iter().take_while(|c| c.span.start < last.start);
+        inside
+            .filter(|c| {
+                first.start < c.span.start
+                    || (first.words_before
+                        && !c.own_line
+                        && c.code_after == first.start
+                        && c.code_before > self.anchor_end)
+            })
+            .map(|c| {
+                // The piece after the one the comment follows starts a line.
+                let next = pieces.partition_point(|p| p.start <= c.span.start).max(1);
+                pieces.get(next).map_or(0, |p| p.level)
+            })
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Whether `pieces` broken at `level` fit in [`WIDTH`] columns.
+    fn fits(&self, pieces: &[Piece], level: u8) -> bool {
+        lines(pieces, level).into_iter().all(|line| {
+            let indent = (self.depth + pieces[line.start].indent) * INDENT;
+            let text = joined(&pieces[line.clone()]);
+            text.split('\n').enumerate().all(|(j, part)| {
+                indent + if j == 0 { 0 } else { 2 * INDENT } + width(part) <= WIDTH
+            })
+        })
     }
 
     fn blank(&mut self) {
-        self.out.push('\n');
+        self.want_blank = true;
     }
 
     /// `head {`, the lines `body` writes, `}`; `head {}` when nothing, not
@@ -246,16 +384,17 @@ impl<'a> Printer<'a> {
     fn block(&mut self, head: &str, start: usize, braces: Span, body: impl FnOnce(&mut Self)) {
         let open = Anchor::open(start, braces);
         let close = Anchor::close(braces);
-        self.comments_before(open, self.depth);
+        self.comments_before(open, self.depth, true);
         let mark = self.out.len();
         let comment_after_brace = self.comments.after.contains_key(&open.start);
         self.write(self.depth, &format!("{head} {{"));
+        self.at_open = true;
         self.comments_after(open);
         let inside = self.out.len();
         self.depth += 1;
         body(self);
         // Comments after the last node go inside the braces.
-        self.comments_before(close, self.depth);
+        self.comments_before(close, self.depth, false);
         self.depth -= 1;
         if self.out.len() == inside && !comment_after_brace {
             self.out.truncate(mark);
@@ -263,6 +402,7 @@ impl<'a> Printer<'a> {
         } else {
             self.write(self.depth, "}");
         }
+        self.at_open = false;
         self.comments_after(close);
     }
 
@@ -290,12 +430,9 @@ impl<'a> Printer<'a> {
         });
     }
 
-    /// A fact-list statement: `init`, `goal`, `pre`, `add` or `del`.
+    /// A fact-list statement: `init`, `goal`, `pre`, `add`, `del` or `contact`.
     fn facts(&mut self, keyword: &str, facts: &Facts) {
-        self.line(
-            Anchor::statement(facts.span, facts.span),
-            &format!("{keyword} {}", self::facts(facts)),
-        );
+        self.statement(fact_pieces(keyword, facts), facts.span.end);
     }
 
     fn task(&mut self, task: &Task) {
@@ -316,7 +453,8 @@ impl<'a> Printer<'a> {
     }
 
     fn action(&mut self, action: &Action) {
-        let mut head = format!("action {}", action.name.text);
+        let se = if action.sequential { "+Se " } else { "" };
+        let mut head = format!("{se}action {}", action.name.text);
         if let Some(description) = &action.description {
             head = format!("{head} {}", string(description));
         }
@@ -337,8 +475,8 @@ impl<'a> Printer<'a> {
             match &action.body {
                 ActionBody::Constraints { goals, paths, durations } => {
                     for g in goals {
-                        let last = g.terms.last().map_or(g.span, |t| t.span);
-                        p.line(Anchor::statement(g.span, last), &goal(g));
+                        let end = g.terms.last().map_or(g.span, |t| t.span).end;
+                        p.statement(goal_pieces(g), end);
                     }
                     for path in paths {
                         let last = match (&path.hardness, path.items.last()) {
@@ -346,7 +484,7 @@ impl<'a> Printer<'a> {
                             (None, Some(item)) => item.span,
                             (None, None) => path.span,
                         };
-                        p.line(Anchor::statement(path.span, last), &self::path(path));
+                        p.statement(path_pieces(path), last.end.max(path.span.end));
                     }
                     for d in durations {
                         p.line(
@@ -360,9 +498,7 @@ impl<'a> Printer<'a> {
                     // The grammar wants an explicit action's solver before its segments.
                     p.solvers(action);
                     for (i, s) in segments.iter().enumerate() {
-                        let joint = if i == 0 { "" } else { "+Tr " };
-                        let anchor = Anchor::statement(s.span, s.braces);
-                        p.line(anchor, &format!("{joint}{}", segment(s)));
+                        p.statement(segment_pieces(s, i > 0), s.braces.end);
                     }
                 }
             }
@@ -370,13 +506,68 @@ impl<'a> Printer<'a> {
     }
 
     fn solvers(&mut self, action: &Action) {
-        for solver in &action.solver {
-            self.line(
-                Anchor::statement(solver.span, solver.span),
-                &format!("solver {}", solver.text),
-            );
+        for statement in &action.solver {
+            let end = statement.entries.last().map_or(statement.span, |e| e.span).end;
+            self.statement(solver_pieces(statement), end);
         }
     }
+}
+
+/// A part of a statement: printed after the one before it on the same
+/// line, or at the start of a line of its own when the statement is broken
+/// at its level.
+#[derive(Debug, Clone)]
+struct Piece {
+    text: String,
+    /// Where its source text starts.
+    start: usize,
+    /// What joins it to the piece before it on one line.
+    joint: &'static str,
+    /// 0 for the first piece; a statement breaks before its pieces of level
+    /// 1 first, then before those of level 2 too.
+    level: u8,
+    /// Indentation levels past the statement's, when it starts a line.
+    indent: usize,
+    /// It is the closing brace of a block printed as a statement (a segment).
+    closes: bool,
+    /// Words of its line come before `start` (a `+Tr`, a keyword before braces).
+    words_before: bool,
+}
+
+impl Piece {
+    fn first(text: String, start: usize) -> Self {
+        Self { text, start, joint: "", level: 0, indent: 0, closes: false, words_before: false }
+    }
+
+    /// A piece after a space, breaking at `level`, indented two levels more
+    /// than its statement when it starts a line: a continuation.
+    fn then(text: String, start: usize, level: u8) -> Self {
+        Self { text, start, joint: " ", level, indent: 2, closes: false, words_before: false }
+    }
+}
+
+/// The lines of `pieces` broken at `level`, as ranges of pieces.
+fn lines(pieces: &[Piece], level: u8) -> Vec<std::ops::Range<usize>> {
+    let mut lines: Vec<std::ops::Range<usize>> = Vec::new();
+    for (i, piece) in pieces.iter().enumerate() {
+        match lines.last_mut() {
+            Some(line) if piece.level == 0 || piece.level > level => line.end = i + 1,
+            _ => lines.push(i..i + 1),
+        }
+    }
+    lines
+}
+
+/// The text of pieces on one line.
+fn joined(pieces: &[Piece]) -> String {
+    let mut text = String::new();
+    for (i, piece) in pieces.iter().enumerate() {
+        if i > 0 {
+            text.push_str(piece.joint);
+        }
+        text.push_str(&piece.text);
+    }
+    text
 }
 
 /// Width of a name in columns (names may hold `θ`).
@@ -475,30 +666,6 @@ fn names(names: &[Name]) -> String {
     names.iter().map(|n| n.text.as_str()).collect::<Vec<_>>().join(" ")
 }
 
-fn facts(facts: &Facts) -> String {
-    if facts.names.is_empty() {
-        "{}".to_owned()
-    } else {
-        let list: Vec<&str> = facts.names.iter().map(|n| n.text.as_str()).collect();
-        format!("{{ {} }}", list.join(", "))
-    }
-}
-
-fn start(start: &Start) -> String {
-    match start {
-        Start::Joints(q) => format!("start {}", vector(q)),
-        Start::State { entries, .. } => {
-            let mut text = "start".to_owned();
-            let mut sep = " ";
-            for (variable, v) in entries {
-                text.push_str(&format!("{sep}{} {}", variable.text, value(v)));
-                sep = if gap(value_unit(v)) == "\n" { "\n" } else { "  " };
-            }
-            text
-        }
-    }
-}
-
 fn shape_keyword(shape: &Shape) -> &str {
     match shape {
         Shape::Box { .. } => "box",
@@ -560,29 +727,6 @@ fn obstacle(o: &Obstacle, name_width: usize, shape_width: usize) -> String {
     }
 }
 
-fn goal(goal: &Goal) -> String {
-    let terms: Vec<String> = goal.terms.iter().map(goal_term).collect();
-    format!("goal {}", terms.join(" > "))
-}
-
-fn goal_term(term: &GoalTerm) -> String {
-    let values = match term.values.as_slice() {
-        [one] => value(one),
-        many => format!("({})", value_list(many)),
-    };
-    format!("{} = {values}", names(&term.variables))
-}
-
-fn path(path: &Path) -> String {
-    let items: Vec<String> = path
-        .items
-        .iter()
-        .map(|item| format!("{} {}", names(&item.variables), feature(&item.feature, false)))
-        .collect();
-    let hardness = path.hardness.as_ref().map(|h| format!(" : {}", h.text)).unwrap_or_default();
-    format!("path {}{hardness}", items.join(", "))
-}
-
 /// A path feature; `in_call` puts a comma before the size, as inside
 /// `.path(about r, 20 deg)`, where it reads as a second argument.
 fn feature(feature: &Feature, in_call: bool) -> String {
@@ -602,26 +746,6 @@ fn feature(feature: &Feature, in_call: bool) -> String {
     }
 }
 
-fn segment(segment: &Segment) -> String {
-    let mut text = "segment".to_owned();
-    let mut before_brace = " ";
-    if let Some(d) = &segment.duration {
-        text.push_str(&format!(" {}", quantity(d)));
-        before_brace = gap(d.unit.as_ref());
-    }
-    let mut body = String::new();
-    for (i, (combine, p)) in segment.primitives.iter().enumerate() {
-        if i > 0 {
-            body.push_str(match combine {
-                Combine::Add => " +Pa ",
-                Combine::Remove => " -Pa ",
-            });
-        }
-        body.push_str(&primitive(p));
-    }
-    format!("{text}{before_brace}{{ {body} }}")
-}
-
 fn primitive(p: &Primitive) -> String {
     let variables = match p.variables.as_slice() {
         [one] => one.text.clone(),
@@ -634,6 +758,164 @@ fn primitive(p: &Primitive) -> String {
         Some(PrimitiveConstraint::Hold) => ".hold".to_owned(),
     };
     format!("{variables}{constraint}")
+}
+
+/// `keyword { a, b }`, breaking after each comma.
+fn fact_pieces(keyword: &str, facts: &Facts) -> Vec<Piece> {
+    let count = facts.names.len();
+    if count == 0 {
+        let piece = Piece::first(format!("{keyword} {{}}"), facts.span.start);
+        return vec![Piece { words_before: true, ..piece }];
+    }
+    facts
+        .names
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            let open = if i == 0 { format!("{keyword} {{ ") } else { String::new() };
+            let close = if i + 1 == count { " }" } else { "," };
+            let text = format!("{open}{}{close}", name.text);
+            if i == 0 {
+                Piece { words_before: true, ..Piece::first(text, facts.span.start) }
+            } else {
+                Piece::then(text, name.span.start, 1)
+            }
+        })
+        .collect()
+}
+
+/// `start [..]`, or `start V v  W w ..`, breaking before each variable.
+fn start_pieces(start: &Start) -> Vec<Piece> {
+    match start {
+        Start::Joints(q) => vec![Piece::first(format!("start {}", vector(q)), q.span.start)],
+        Start::State { entries, span } => {
+            let mut pieces: Vec<Piece> = Vec::new();
+            for (variable, v) in entries {
+                let text = format!("{} {}", variable.text, value(v));
+                match pieces.last() {
+                    None => pieces.push(Piece::first(format!("start {text}"), span.start)),
+                    Some(_) => pieces.push(Piece::then(text, variable.span.start, 1)),
+                }
+            }
+            // After a unit the grammar does not know, the next entry goes on
+            // a line of its own (see [`gap`]).
+            for i in 1..pieces.len() {
+                let (_, before) = &entries[i - 1];
+                pieces[i].joint = if gap(value_unit(before)) == "\n" { "\n" } else { "  " };
+            }
+            pieces
+        }
+    }
+}
+
+/// `goal A = a > B = (b1, b2)`: breaking before `>` first, then after each
+/// comma of a value list.
+fn goal_pieces(goal: &Goal) -> Vec<Piece> {
+    let mut pieces: Vec<Piece> = Vec::new();
+    for (t, term) in goal.terms.iter().enumerate() {
+        let head = if t == 0 { "goal " } else { "> " };
+        let variables = format!("{head}{} = ", names(&term.variables));
+        let term_start = if t == 0 { goal.span.start } else { term.span.start };
+        let push = |pieces: &mut Vec<Piece>, text: String, start: usize, level: u8| {
+            pieces.push(if pieces.is_empty() {
+                Piece::first(text, start)
+            } else {
+                Piece::then(text, start, level)
+            });
+        };
+        match term.values.as_slice() {
+            [one] => push(&mut pieces, format!("{variables}{}", value(one)), term_start, 1),
+            many => {
+                for (i, v) in many.iter().enumerate() {
+                    let close = if i + 1 == many.len() { ")" } else { "," };
+                    if i == 0 {
+                        push(
+                            &mut pieces,
+                            format!("{variables}({}{close}", value(v)),
+                            term_start,
+                            1,
+                        );
+                    } else {
+                        push(&mut pieces, format!("{}{close}", value(v)), v.span().start, 2);
+                    }
+                }
+            }
+        }
+    }
+    pieces
+}
+
+/// `solver qp` or `solver MS1 rrt, MS2 qp`, breaking after each comma.
+fn solver_pieces(statement: &SolverStatement) -> Vec<Piece> {
+    let count = statement.entries.len();
+    statement
+        .entries
+        .iter()
+        .enumerate()
+        .map(|(i, entry)| {
+            let mut text = match &entry.segment {
+                Some(segment) => format!("{} {}", segment.text, entry.solver.text),
+                None => entry.solver.text.clone(),
+            };
+            if i + 1 < count {
+                text.push(',');
+            }
+            if i == 0 {
+                Piece::first(format!("solver {text}"), statement.span.start)
+            } else {
+                Piece::then(text, entry.span.start, 1)
+            }
+        })
+        .collect()
+}
+
+/// `path item, item : hard`, breaking after each comma.
+fn path_pieces(path: &Path) -> Vec<Piece> {
+    let count = path.items.len();
+    let hardness = path.hardness.as_ref().map(|h| format!(" : {}", h.text)).unwrap_or_default();
+    path.items
+        .iter()
+        .enumerate()
+        .map(|(i, item)| {
+            let mut text = format!("{} {}", names(&item.variables), feature(&item.feature, false));
+            if i + 1 == count {
+                text.push_str(&hardness);
+            } else {
+                text.push(',');
+            }
+            if i == 0 {
+                Piece::first(format!("path {text}"), path.span.start)
+            } else {
+                Piece::then(text, item.span.start, 1)
+            }
+        })
+        .collect()
+}
+
+/// `[+Tr ]segment D { P +Pa P }`: broken, its primitives go inside the
+/// braces on a line of their own, then one a line.
+fn segment_pieces(segment: &Segment, after_another: bool) -> Vec<Piece> {
+    let mut head = if after_another { "+Tr segment" } else { "segment" }.to_owned();
+    let mut before_brace = " ";
+    if let Some(d) = &segment.duration {
+        head.push_str(&format!(" {}", quantity(d)));
+        before_brace = gap(d.unit.as_ref());
+    }
+    let first = Piece::first(format!("{head}{before_brace}{{"), segment.span.start);
+    let mut pieces = vec![Piece { words_before: after_another, ..first }];
+    for (i, (combine, p)) in segment.primitives.iter().enumerate() {
+        let operator = match (i, combine) {
+            (0, _) => "",
+            (_, Combine::Add) => "+Pa ",
+            (_, Combine::Remove) => "-Pa ",
+        };
+        let level = if i == 0 { 1 } else { 2 };
+        let text = format!("{operator}{}", primitive(p));
+        pieces.push(Piece { indent: 1, ..Piece::then(text, p.span.start, level) });
+    }
+    let close = segment.braces.end.saturating_sub(1);
+    pieces.push(Piece { indent: 0, closes: true, ..Piece::then("}".to_owned(), close, 1) });
+    pieces
 }
 
 #[cfg(test)]
@@ -714,7 +996,8 @@ task push_box_a_aside {
     pre { holding }
     add { hand_empty }
     del { holding }
-    goal Pw Ow = ([0.25, -0.28, -0.05], rpy(180, 0, 90) deg) > Os = axes(r: [0, 0, -1], l: [0, 1, 0])
+    goal Pw Ow = ([0.25, -0.28, -0.05], rpy(180, 0, 90) deg)
+        > Os = axes(r: [0, 0, -1], l: [0, 1, 0])
     duration 2 s
   }
 
@@ -726,7 +1009,7 @@ task push_box_a_aside {
     path Os about z, θe hold : hard
   }
 
-  action push {
+  +Se action push {
     pre { box_b_moved }
     add { box_a_aside }
     contact { box_a, ball }
@@ -737,8 +1020,12 @@ task push_box_a_aside {
   action type_vii explicit {
     contact { bar }
     solver rrt
-    segment 1.2 s { Os.path(about r, 24.7 deg) +Pa (θe Ow).goal(100 deg, rpy(-15.5, -11.5, -104.6) deg) }
-    +Tr segment 1 s { (Pw Ow).goal([0.27, -0.1, 0.05], axes(f: [1, 0, 0], p: [0, 1, 0])) +Pa θsw.hold }
+    segment 1.2 s {
+      Os.path(about r, 24.7 deg) +Pa (θe Ow).goal(100 deg, rpy(-15.5, -11.5, -104.6) deg)
+    }
+    +Tr segment 1 s {
+      (Pw Ow).goal([0.27, -0.1, 0.05], axes(f: [1, 0, 0], p: [0, 1, 0])) +Pa θsw.hold
+    }
     +Tr segment 0.8 s { (Pw Ow).hold +Pa θsw.goal(63.2 deg) }
     +Tr segment { (Pw Ow sw).hold -Pa sw +Pa sw.path(by 10 deg) }
   }
@@ -821,6 +1108,7 @@ task push_box_a_aside {   # the task
 
     const COMMENTED_CANONICAL: &str = r#"# header comment
 // second header line
+
 robot "../../robots/coman_right_arm.urdf" # path relative to this file
 start [0, -20, 0, -60, 0, 10, 0] deg // joints
 
@@ -847,15 +1135,16 @@ settings {
 task push_box_a_aside { # the task
   init { holding, box_b_near_a }
   # the goal facts
-  goal { box_a_aside, hand_empty } # first
+  goal { box_a_aside, # first
+      hand_empty }
 
   # drops
   action drop "Drop the # things // in the hand" {
     pre { holding }
     add { hand_empty }
     del { holding } # three on a line
-    goal Pw Ow = ([0.25, -0.28, -0.05], rpy(180, 0, 90) deg) > Os = axes(r: [0, 0, -1], l: [0, 1, 0]) # first goal
-    # second goal
+    goal Pw Ow = ([0.25, -0.28, -0.05], rpy(180, 0, 90) deg) # first goal
+        > Os = axes(r: [0, 0, -1], l: [0, 1, 0]) # second goal
     duration 2 s
   } # end of drop
 
@@ -864,12 +1153,13 @@ task push_box_a_aside { # the task
     add { box_b_moved }
     del { box_b_near_a }
     goal Pw Ow = ([0.15, -0.25, 0.05], rpy(180, 0, 90) deg)
-    path Os about z, θe hold : hard # about z
-    # then
+    path Os about z, # about z
+        # then
+        θe hold : hard
     # end of retract
   }
 
-  action push { # sequential
+  +Se action push { # sequential
     pre { box_b_moved }
     add { box_a_aside }
     contact { box_a } # pushed
@@ -879,9 +1169,14 @@ task push_box_a_aside { # the task
 
   action type_vii explicit { # header
     // before the first segment
-    segment 1.2 s { Os.path(about r, 24.7 deg) +Pa (θe Ow).goal(100 deg, rpy(-15.5, -11.5, -104.6) deg) } # first segment
-    # parallel
-    +Tr segment 1 s { (Pw Ow).goal([0.27, -0.1, 0.05], axes(f: [1, 0, 0], p: [0, 1, 0])) +Pa θsw.hold }
+    segment 1.2 s { # first segment
+      Os.path(about r, 24.7 deg)
+      # parallel
+      +Pa (θe Ow).goal(100 deg, rpy(-15.5, -11.5, -104.6) deg)
+    }
+    +Tr segment 1 s {
+      (Pw Ow).goal([0.27, -0.1, 0.05], axes(f: [1, 0, 0], p: [0, 1, 0])) +Pa θsw.hold
+    }
     # third
     +Tr segment 0.8 s { (Pw Ow).hold +Pa θsw.goal(63.2 deg) }
     +Tr segment { (Pw Ow sw).hold -Pa sw +Pa sw.path(by 10 deg) } // last
@@ -970,11 +1265,65 @@ task push_box_a_aside { # the task
             "// header\nrobot   \"a.urdf\" # trailing  \r\n\n\n  start [ 0,0 , 0,0,0,0,0 ]rad\n";
         assert_eq!(
             canonical(text),
-            "// header\nrobot \"a.urdf\" # trailing\nstart [0, 0, 0, 0, 0, 0, 0] rad\n"
+            "// header\nrobot \"a.urdf\" # trailing\n\nstart [0, 0, 0, 0, 0, 0, 0] rad\n"
         );
         assert_eq!(canonical(""), "");
         assert_eq!(canonical("# only a comment\n"), "# only a comment\n");
-        assert_eq!(canonical("\u{FEFF}  # one\n\n\n// two"), "# one\n// two\n");
+        assert_eq!(canonical("\u{FEFF}  # one\n\n\n// two"), "# one\n\n// two\n");
+    }
+
+    #[test]
+    fn solvers_per_segment_round_trip() {
+        assert_eq!(
+            canonical("task t { action a { goal θsw = 1 solver qp,MS2   rrt # why\n } }"),
+            "task t {\n  action a {\n    goal θsw = 1\n    solver qp, MS2 rrt # why\n  }\n}\n"
+        );
+    }
+
+    #[test]
+    fn blank_lines_stay_one_at_most() {
+        let text = "robot \"a.urdf\"\n\n\n\nstart [0, 0, 0, 0, 0, 0, 0]\ntask t {\n\n  action a {\n    goal Pw = [0, 0, 0]\n\n\n    # then\n    path Ow hold\n\n  }\n}\n";
+        assert_eq!(
+            canonical(text),
+            "robot \"a.urdf\"\n\nstart [0, 0, 0, 0, 0, 0, 0]\n\ntask t {\n  action a {\n    goal Pw = [0, 0, 0]\n\n    # then\n    path Ow hold\n  }\n}\n"
+        );
+    }
+
+    #[test]
+    fn long_statements_break_at_the_fewest_places() {
+        let values = "([0.25, -0.28, -0.05], rpy(180, 0, 90) deg)";
+        let os = "axes(r: [0.544, -0.824, -0.161], l: [0.3, 0.37, -0.879])";
+        let text = format!("task t {{ action a {{ goal Pw Ow = {values} > Os = {os} }} }}");
+        let printed = canonical(&text);
+        assert!(
+            printed.contains(&format!("    goal Pw Ow = {values}\n        > Os = {os}\n")),
+            "{printed}"
+        );
+        // Every line fits, and a line too long even at the first level
+        // breaks the value lists too.
+        let long = "[0.250000001, -0.280000001, -0.050000001]";
+        let text = format!(
+            "task t {{ action a {{ goal Pw Ow θsw = ({long}, rpy(180.000001, 0.000001, 90.000001) deg, 63.2 deg) }} }}"
+        );
+        let printed = canonical(&text);
+        assert!(printed.lines().all(|l| l.chars().count() <= WIDTH), "{printed}");
+        assert!(
+            printed.contains(&format!("    goal Pw Ow θsw = ({long},\n        rpy(")),
+            "{printed}"
+        );
+        let names: Vec<String> = (0..20).map(|i| format!("fact_number_{i}")).collect();
+        let text = format!(
+            "task t {{ init {{ {0} }} goal {{ {0} }} action a {{ goal θsw = 1 }} }}",
+            names.join(", ")
+        );
+        let printed = canonical(&text);
+        assert!(printed.lines().all(|l| l.chars().count() <= WIDTH), "{printed}");
+        assert!(printed.contains("  init { fact_number_0,\n      fact_number_1,\n"), "{printed}");
+        let text = "task t { action a explicit { segment 1 s { Pw.goal([0.179, 0.101, -0.165]) +Pa Ow.goal(rpy(-17.7, -6.2, 46.2) deg) +Pa θsw.goal(22.9 deg) } } }";
+        assert_eq!(
+            canonical(text),
+            "task t {\n  action a explicit {\n    segment 1 s {\n      Pw.goal([0.179, 0.101, -0.165]) +Pa Ow.goal(rpy(-17.7, -6.2, 46.2) deg) +Pa θsw.goal(22.9 deg)\n    }\n  }\n}\n"
+        );
     }
 
     #[test]
@@ -1003,6 +1352,7 @@ action b { goal θsw = 1 } }";
             canonical(text),
             "# robot
 robot \"a.urdf\"
+
 # start
 start [0, 0, 0, 0, 0, 0, 0]
 
@@ -1058,11 +1408,11 @@ scene {
 task t {
   action a {
     goal Pw = [0, 0, 0] # goal
-    path Ow hold, θsw hold # Ow
-    # θsw
+    path Ow hold, # Ow
+        θsw hold # θsw
   } # a
 
-  action b { # after +Se
+  +Se action b { # after +Se
     goal Ow = rpy(0, 0, 0)
   }
 } # t
@@ -1168,13 +1518,16 @@ task t { action a # the action
 task t {
   action a explicit { # the action
     # segments follow
-    pre { x, z }
-    # y is not needed
+    pre { x,
+        # y is not needed
+        z }
     solver qp // the solver
     # first segment
-    segment 1 s { Pw.hold +Pa Ow.hold }
-    # inside, before the first primitive
-    # hold
+    segment 1 s {
+      # inside, before the first primitive
+      Pw.hold # hold
+      +Pa Ow.hold
+    }
     +Tr segment { (Pw Ow θsw).hold }
   }
 }

@@ -21,7 +21,7 @@ use std::path::Path;
 pub use bounds::{Limits, MAX_ANGLE, MAX_LENGTH, ReadError, read_source, samples};
 pub use diagnostic::{Diagnostic, Diagnostics};
 pub use edit::{EditError, with_goal};
-pub use format::format;
+pub use format::{WIDTH, format};
 pub use task::*;
 
 /// Why a task file could not be read.

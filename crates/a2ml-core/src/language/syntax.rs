@@ -24,7 +24,23 @@ pub fn parse_file(text: &str) -> Result<ast::File, Diagnostic> {
     Ok(ast::File {
         items: file.into_inner().filter(|p| p.as_rule() != Rule::EOI).map(item).collect(),
         comments: comments(text),
+        layout: ast::Layout { blank_lines: blank_lines(text) },
     })
+}
+
+/// The first byte of every line of `text` that holds only whitespace and
+/// ends in a line break.
+fn blank_lines(text: &str) -> Vec<usize> {
+    let mut starts = Vec::new();
+    let mut line_start = 0;
+    for line in text.split_inclusive('\n') {
+        if line.trim_matches(|c| c == '\n' || BLANK.contains(&c)).is_empty() && line.ends_with('\n')
+        {
+            starts.push(line_start);
+        }
+        line_start += line.len();
+    }
+    starts
 }
 
 /// The comments of a text that parses, in order.
@@ -49,6 +65,7 @@ fn comments(text: &str) -> Vec<ast::Comment> {
                 text: comment.to_owned(),
                 own_line: !code_on_line,
                 code_before: code_end,
+                code_after: text.len(),
                 span: Span { start: i, end: i + comment.len() },
             });
             while chars.next_if(|&(j, _)| j < line_end).is_some() {}
@@ -72,6 +89,20 @@ fn comments(text: &str) -> Vec<ast::Comment> {
                 code_end = i + c.len_utf8();
             }
         }
+    }
+    // The code after each comment: the next byte that is neither
+    // whitespace nor in a comment, found from the last comment back.
+    let mut next_code = text.len();
+    for i in (0..found.len()).rev() {
+        let end = found[i].span.end;
+        let rest = &text[end..];
+        let skipped =
+            rest.len() - rest.trim_start_matches(|c| c == '\n' || BLANK.contains(&c)).len();
+        let after = end + skipped;
+        if found.get(i + 1).is_none_or(|next| next.span.start != after) {
+            next_code = after;
+        }
+        found[i].code_after = next_code;
     }
     found
 }
@@ -372,9 +403,7 @@ fn obstacle(node: Node<'_>) -> ast::Obstacle {
     let shape = match rule {
         Rule::box_shape => ast::Shape::Box { at: v(), size: v(), orientation },
         Rule::sphere_shape => ast::Shape::Sphere { at: v(), radius: q() },
-        Rule::capsule_shape if ends => {
-            ast::Shape::Capsule { from: v(), to: v(), radius: q() }
-        }
+        Rule::capsule_shape if ends => ast::Shape::Capsule { from: v(), to: v(), radius: q() },
         Rule::capsule_shape => {
             ast::Shape::CapsuleAt { at: v(), radius: q(), height: q(), orientation }
         }
@@ -409,12 +438,17 @@ fn task(node: Node<'_>) -> ast::Task {
         goal: Vec::new(),
         actions: Vec::new(),
     };
+    let mut sequential = false;
     for n in inner {
         match n.as_rule() {
             Rule::init => out.init.push(facts(first_inner(n))),
             Rule::task_goal => out.goal.push(facts(first_inner(n))),
-            Rule::action => out.actions.push(action(n)),
-            _ => {} // +Se: actions are sequential whether or not it is written.
+            Rule::action => {
+                out.actions.push(ast::Action { sequential, ..action(n) });
+                sequential = false;
+            }
+            // Actions are sequential whether or not `+Se` is written.
+            _ => sequential = true,
         }
     }
     out
@@ -428,6 +462,7 @@ fn action(node: Node<'_>) -> ast::Action {
         braces: Span::default(),
         name: action_name,
         description: None,
+        sequential: false,
         pre: Vec::new(),
         add: Vec::new(),
         del: Vec::new(),
@@ -478,8 +513,23 @@ fn common_statement(action: &mut ast::Action, node: Node<'_>) {
         Rule::add => action.add.push(facts(first_inner(node))),
         Rule::del => action.del.push(facts(first_inner(node))),
         Rule::contact => action.contact.push(facts(first_inner(node))),
-        _ => action.solver.push(name(first_inner(node))),
+        _ => action.solver.push(solver_statement(node)),
     }
+}
+
+fn solver_statement(node: Node<'_>) -> ast::SolverStatement {
+    let whole = span(&node);
+    let keyword = Span { start: whole.start, end: whole.start + "solver".len() };
+    let entries = node
+        .into_inner()
+        .map(|entry| {
+            let entry_span = span(&entry);
+            let mut names: Vec<Name> = entry.into_inner().map(name).collect();
+            let solver = names.pop().expect("an entry names a solver");
+            ast::SolverEntry { segment: names.pop(), solver, span: entry_span }
+        })
+        .collect();
+    ast::SolverStatement { entries, span: keyword }
 }
 
 fn goal(node: Node<'_>) -> ast::Goal {

@@ -298,6 +298,26 @@ impl SolverChoice {
     }
 }
 
+/// A solver chosen for one segment of an action: `solver MS2 rrt`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SegmentSolver {
+    /// The segment's index in its action, from 0 (`MS1` is 0).
+    pub segment: usize,
+    /// The solver.
+    pub solver: SolverChoice,
+    /// Where the entry was written.
+    pub span: Span,
+}
+
+impl Action {
+    /// The solver chosen for the action's segment `segment` (from 0): its
+    /// own, else the action's, if any.
+    pub fn solver_of(&self, segment: usize) -> Option<SolverChoice> {
+        let own = self.segment_solvers.iter().find(|s| s.segment == segment);
+        own.map(|s| s.solver).or(self.solver)
+    }
+}
+
 /// One action of a task.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Action {
@@ -315,8 +335,11 @@ pub struct Action {
     /// (the box a push moves): every collision check of the action leaves
     /// them out. See [`Task::action_scene`].
     pub contact: Vec<String>,
-    /// Solver for this action, if chosen.
+    /// Solver for this action's segments, if chosen.
     pub solver: Option<SolverChoice>,
+    /// Solvers chosen for single segments (`solver MS1 rrt`), before
+    /// [`Action::solver`].
+    pub segment_solvers: Vec<SegmentSolver>,
     /// Constraints or segments.
     pub body: ActionBody,
     /// Where its name was written.

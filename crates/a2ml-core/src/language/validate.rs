@@ -663,6 +663,67 @@ impl Checker<'_> {
         }
     }
 
+    /// An action's `solver` statement: the solver of its segments and those
+    /// of single segments, `MS1` the first. `segments` is the number of an
+    /// explicit action's segments; an action decomposed has its segments
+    /// checked by the decomposition.
+    fn solver_statement(
+        &mut self,
+        statement: &ast::SolverStatement,
+        action: &str,
+        segments: Option<usize>,
+    ) -> (Option<SolverChoice>, Vec<SegmentSolver>) {
+        let mut whole = None;
+        let mut seen_whole = false;
+        let mut single: Vec<SegmentSolver> = Vec::new();
+        for entry in &statement.entries {
+            let solver = self.solver(&entry.solver);
+            let Some(segment) = &entry.segment else {
+                if seen_whole {
+                    self.error(
+                        entry.span,
+                        "one solver for the whole action; name the segment of the others (`MS2 rrt`)",
+                    );
+                }
+                seen_whole = true;
+                whole = whole.or(solver);
+                continue;
+            };
+            let index = segment
+                .text
+                .strip_prefix("MS")
+                .and_then(|k| k.parse::<usize>().ok())
+                .filter(|&k| k >= 1 && !segment.text[2..].starts_with('0'));
+            let Some(k) = index else {
+                self.error(
+                    segment.span,
+                    format!(
+                        "`{}` is not a segment: segments are named MS1, MS2, ... in their action",
+                        segment.text
+                    ),
+                );
+                continue;
+            };
+            if let Some(count) = segments.filter(|&count| k > count) {
+                let names: Vec<String> = (1..=count).map(|i| format!("MS{i}")).collect();
+                self.error(
+                    segment.span,
+                    format!(
+                        "action `{action}` has {count} segment{} ({}): there is no {}",
+                        if count == 1 { "" } else { "s" },
+                        names.join(", "),
+                        segment.text
+                    ),
+                );
+            } else if single.iter().any(|s| s.segment == k - 1) {
+                self.error(segment.span, format!("{} has a solver already", segment.text));
+            } else if let Some(solver) = solver {
+                single.push(SegmentSolver { segment: k - 1, solver, span: entry.span });
+            }
+        }
+        (whole, single)
+    }
+
     fn solver(&mut self, name: &Name) -> Option<SolverChoice> {
         let found = SolverChoice::NAMES.iter().find(|(n, _)| *n == name.text).map(|(_, s)| *s);
         if found.is_none() {
@@ -670,7 +731,10 @@ impl Checker<'_> {
                 .map(|s| format!("did you mean `{s}`?"));
             self.error_with_help(
                 name.span,
-                format!("unknown solver `{}` (auto, qp, rrt, map, gpm, clik, pmp, hamp)", name.text),
+                format!(
+                    "unknown solver `{}` (auto, qp, rrt, map, gpm, clik, pmp, hamp)",
+                    name.text
+                ),
                 help,
             );
         }
@@ -870,7 +934,14 @@ impl Checker<'_> {
         if let Some(extra) = a.solver.get(1) {
             self.error(extra.span, "`solver` is given twice");
         }
-        let solver = a.solver.first().and_then(|s| self.solver(s));
+        let segments = match &a.body {
+            ast::ActionBody::Explicit { segments } => Some(segments.len()),
+            ast::ActionBody::Constraints { .. } => None,
+        };
+        let (solver, segment_solvers) = match a.solver.first() {
+            Some(statement) => self.solver_statement(statement, &a.name.text, segments),
+            None => (None, Vec::new()),
+        };
         let body = match &a.body {
             ast::ActionBody::Constraints { goals, paths, durations } => {
                 for g in goals.iter().skip(1) {
@@ -921,6 +992,7 @@ impl Checker<'_> {
             del,
             contact,
             solver,
+            segment_solvers,
             body,
             span: a.name.span,
         })
@@ -1039,9 +1111,10 @@ impl Checker<'_> {
             }
             Some(ast::Orientation::Axis(vector)) => {
                 let axis = self.direction(vector, "the axis")?;
-                Some(Rotation3::rotation_between(&Vector3::z(), &axis).unwrap_or_else(|| {
-                    Rotation3::from_axis_angle(&Vector3::x_axis(), PI)
-                }))
+                Some(
+                    Rotation3::rotation_between(&Vector3::z(), &axis)
+                        .unwrap_or_else(|| Rotation3::from_axis_angle(&Vector3::x_axis(), PI)),
+                )
             }
         }
     }

@@ -46,7 +46,11 @@ pub struct FrameMetrics {
 }
 
 /// The per-frame measures of `trajectory` on `robot`.
-pub fn frame_metrics(robot: &Robot, trajectory: &Trajectory, options: &RulaOptions) -> FrameMetrics {
+pub fn frame_metrics(
+    robot: &Robot,
+    trajectory: &Trajectory,
+    options: &RulaOptions,
+) -> FrameMetrics {
     let n = trajectory.len();
     let mut frames = FrameMetrics {
         speeds: ElementSpeeds { times: trajectory.times().to_vec(), ..ElementSpeeds::default() },
@@ -249,7 +253,8 @@ pub fn analyze(
     options: &MetricsOptions,
 ) -> Analysis {
     let frames = frame_metrics(robot, trajectory, &options.rula);
-    let whole = Span { label: "whole".to_owned(), start: trajectory.start(), end: trajectory.end() };
+    let whole =
+        Span { label: "whole".to_owned(), start: trajectory.start(), end: trajectory.end() };
     let whole = span_metrics(&frames, &whole, options);
     let segments = spans.iter().map(|s| span_metrics(&frames, s, options)).collect();
     Analysis { frames, whole, segments }

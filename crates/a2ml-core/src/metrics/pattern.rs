@@ -42,7 +42,8 @@ impl Primitive {
 
 impl fmt::Display for Primitive {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (moves, symbol) in [(self.swivel, "Φ"), (self.position, "P"), (self.orientation, "O")] {
+        for (moves, symbol) in [(self.swivel, "Φ"), (self.position, "P"), (self.orientation, "O")]
+        {
             if moves {
                 f.write_str(symbol)?;
             }
@@ -472,10 +473,8 @@ pub fn connection_similarity(
     }
     let (of_h, of_s): (BTreeSet<_>, BTreeSet<_>) =
         (connections(h).into_iter().collect(), connections(s).into_iter().collect());
-    let changed: Real = of_h
-        .symmetric_difference(&of_s)
-        .map(|c| frequencies.get(c).copied().unwrap_or(0.0))
-        .sum();
+    let changed: Real =
+        of_h.symmetric_difference(&of_s).map(|c| frequencies.get(c).copied().unwrap_or(0.0)).sum();
     (total - (1.0 - target_share) * changed) / total
 }
 

@@ -228,7 +228,8 @@ pub fn rula_angles(
     let k = u.cross(&l);
     let limits = &robot.joints[FOREARM_ROLL].limits;
     let half_range = 0.5 * (limits.upper - limits.lower);
-    let twist = if half_range > 0.0 { ((q_roll - limits.middle()) / half_range).abs() } else { 0.0 };
+    let twist =
+        if half_range > 0.0 { ((q_roll - limits.middle()) / half_range).abs() } else { 0.0 };
     Ok(RulaAngles {
         upper_arm_flexion: r.dot(&forward).atan2(down),
         upper_arm_abduction: r.dot(&outward).atan2(down),

@@ -89,9 +89,8 @@ pub fn path_normalised_jerk<const N: usize>(times: &[Real], samples: &[SVector<R
         return 0.0;
     }
     let middles: Vec<Real> = times[..n].windows(2).map(|w| 0.5 * (w[0] + w[1])).collect();
-    let velocities: Vec<SVector<Real, N>> = (1..n)
-        .map(|k| (samples[k] - samples[k - 1]) / (times[k] - times[k - 1]))
-        .collect();
+    let velocities: Vec<SVector<Real, N>> =
+        (1..n).map(|k| (samples[k] - samples[k - 1]) / (times[k] - times[k - 1])).collect();
     normalised_jerk(&middles, &velocities)
 }
 

@@ -691,12 +691,13 @@ pub fn outline(o: &Obstacle, h: usize, v: usize) -> Vec<Vec<(Real, Real)>> {
     let at = |p: &Vector3| (p[h], p[v]);
     match &o.shape {
         Shape::Box { center, size, rotation } => {
-            let corners = (0..8).map(|k| {
-                let corner = Vector3::from_fn(|i, _| {
-                    if k >> i & 1 == 1 { 0.5 * size[i] } else { -0.5 * size[i] }
+            let corners =
+                (0..8).map(|k| {
+                    let corner = Vector3::from_fn(|i, _| {
+                        if k >> i & 1 == 1 { 0.5 * size[i] } else { -0.5 * size[i] }
+                    });
+                    at(&(center + rotation * corner))
                 });
-                at(&(center + rotation * corner))
-            });
             vec![hull(corners.collect())]
         }
         Shape::Sphere { center, radius } => vec![circle(at(center), *radius)],

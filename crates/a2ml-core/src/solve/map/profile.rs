@@ -74,7 +74,10 @@ pub fn plan_profile(
     let model = CollisionModel::new(robot, &CollisionScene::new(obstacles));
     let at_start = clearance(&model, start);
     if at_start < options.safety_distance {
-        return Err(MapError::StartBlocked { clearance: at_start, safety: options.safety_distance });
+        return Err(MapError::StartBlocked {
+            clearance: at_start,
+            safety: options.safety_distance,
+        });
     }
     let path = search(map, start_swivel, targets, options)?;
     let duration = map.times.last().copied().unwrap_or(0.0);
