@@ -15,6 +15,7 @@ mod metrics;
 mod map;
 mod opt;
 mod output;
+mod paper;
 mod plan;
 mod plot;
 mod profile;
