@@ -19,6 +19,7 @@ mod mbm_problems;
 mod metrics;
 mod opt;
 mod output;
+mod paper;
 mod plan;
 mod plot;
 mod profile;

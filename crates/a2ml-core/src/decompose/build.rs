@@ -324,10 +324,16 @@ impl Planner<'_> {
             ActionType::VI | ActionType::VII => {
                 let path = path.ok_or_else(|| self.unreachable(0, "a path is needed".into()))?;
                 // The goal configuration: G1 with the rest of its space from Opt1.
-                let g4 = self.opt1_complement(0, goal_space, &g1, &g2, &q, &mut record)?;
-                let mut whole = g1.clone();
-                whole.extend(g4.iter().copied());
-                let sol2 = opt2(self.robot, &whole, path, &q, Some(self.scene), opt)
+                let goal = opt1(self.robot, &g1, &g2, &q, Some(self.scene), opt)
+                    .map_err(|e| self.opt_failed(0, e))?;
+                record("Opt1", &goal);
+                let g4 = complement_targets(goal_space, &g1, &goal.state);
+                // Eq. 14: the end of the path nearest the goal configuration (G1, G4),
+                // measured in the path's own space, where the variables left free at
+                // the end of the path (G5) are matched one for one (docs/paper.md).
+                let nearest: Targets =
+                    path_space.variables().into_iter().map(|v| (v, goal.state.value(v))).collect();
+                let sol2 = opt2(self.robot, &nearest, path, &q, Some(self.scene), opt)
                     .map_err(|e| self.opt_failed(0, e))?;
                 record("Opt2", &sol2);
                 let fill = Fill::GoalAt(sol2.state);
