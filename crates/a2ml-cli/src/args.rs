@@ -88,19 +88,16 @@ pub struct ArmArgs {
 }
 
 impl ArmArgs {
-    /// The robot options: these arguments over the task's `base`/`tip`, and
-    /// the package path with the environment's folders after `--package-path`.
+    /// The robot options: `--base`/`--tip` (a task's own `base`/`tip` come second, in
+    /// [`a2ml_core::language::Task::load_robot`]), and the package path with the
+    /// environment's folders after `--package-path`.
     ///
     /// # Errors
     /// A message when the skeleton radius is negative or not finite.
-    pub fn options(
-        &self,
-        task_base: Option<&str>,
-        task_tip: Option<&str>,
-    ) -> Result<a2ml_core::RobotOptions, crate::error::CliError> {
+    pub fn options(&self) -> Result<a2ml_core::RobotOptions, crate::error::CliError> {
         let mut options = a2ml_core::RobotOptions {
-            base: self.base.clone().or(task_base.map(str::to_owned)),
-            tip: self.tip.clone().or(task_tip.map(str::to_owned)),
+            base: self.base.clone(),
+            tip: self.tip.clone(),
             ..a2ml_core::RobotOptions::default()
         };
         let geometry = &mut options.geometry;

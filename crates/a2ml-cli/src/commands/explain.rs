@@ -62,8 +62,7 @@ pub struct ExplainArgs {
 /// stderr first), the robot is unusable, or the decomposition fails.
 pub fn run(args: &ExplainArgs) -> Result<(), CliError> {
     let (task, source) = super::load_task(&args.file, &args.limits.limits())?;
-    let options = args.arm.options(task.robot_base.as_deref(), task.robot_tip.as_deref())?;
-    let robot = Robot::from_urdf_file_with(&task.robot, &options)?;
+    let robot = task.load_robot(&args.arm.options()?)?;
     let decomposition = decompose::decompose(&robot, &task, &DecomposeOptions::default())
         .map_err(|e| decomposition_error(&args.file, &source, &e))?;
     let report = ExplainReport::new(&args.file, &robot, &task, &decomposition);

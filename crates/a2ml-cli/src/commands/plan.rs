@@ -224,7 +224,7 @@ impl<'a> Planning<'a> {
             read.extend(inputs.iter().map(PathBuf::as_path));
             output::check_not_an_input(path, &read)?;
         }
-        let robot = task.load_robot(&args.arm.options(None, None)?)?;
+        let robot = task.load_robot(&args.arm.options()?)?;
         let options = PlanOptions {
             solver: args.solver,
             rate: args.rate,

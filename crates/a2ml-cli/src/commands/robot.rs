@@ -92,7 +92,7 @@ pub fn parse_configuration(text: &str) -> Result<Configuration, String> {
 /// [`CliError::Io`] when the URDF cannot be read, [`CliError::Input`] when it
 /// holds no usable 7-joint arm or a link name is unknown.
 pub fn run(args: &RobotArgs) -> Result<(), CliError> {
-    let options = args.arm.options(None, None)?;
+    let options = args.arm.options()?;
     // A device or a pipe would be read without end.
     if std::fs::metadata(&args.urdf).is_ok_and(|m| !m.is_file()) {
         let path = args.urdf.display();
