@@ -97,8 +97,12 @@ fn the_qp_stalls_on_the_line_at_the_forward_bar_and_auto_goes_on_to_the_rrt() {
     assert!(error < 1e-3, "the QP leaves the line by {:.2} mm", error * 1e3);
     assert!(segment.stalled && !segment.reached, "{:?}", segment.errors);
     assert!(!qp.reached());
-    assert!(qp.warnings.iter().any(|w| w.contains("stalled")), "{:?}", qp.warnings);
-    assert!(!qp.warnings.iter().any(|w| w.contains("left its hard path")), "{:?}", qp.warnings);
+    assert!(qp.warnings.iter().any(|w| w.message.contains("stalled")), "{:?}", qp.warnings);
+    assert!(
+        !qp.warnings.iter().any(|w| w.message.contains("left its hard path")),
+        "{:?}",
+        qp.warnings
+    );
     let clearance = dense_clearance(&robot, &scene(&task, &robot), qp.trajectory.positions());
     assert!(clearance >= qp.safety_distance - 1e-4, "{:.2} mm", clearance * 1e3);
 
@@ -132,7 +136,7 @@ fn no_path_passes_the_lateral_bar_and_auto_keeps_the_qps_closest_result() {
     let error = line_error(&robot, &plan);
     assert!(error < 1e-3, "the QP leaves the line by {:.2} mm", error * 1e3);
     let kept = "rrt: no path found in 2000 samples";
-    assert!(plan.warnings.iter().any(|w| w.contains(kept)), "{:?}", plan.warnings);
+    assert!(plan.warnings.iter().any(|w| w.message.contains(kept)), "{:?}", plan.warnings);
     let clearance = dense_clearance(&robot, &scene(&task, &robot), plan.trajectory.positions());
     assert!(clearance >= plan.safety_distance - 1e-4, "{:.2} mm", clearance * 1e3);
 }

@@ -30,5 +30,6 @@ mod rrt;
 mod scene;
 mod segments;
 mod smoothness;
+mod spelling;
 mod swivel;
 mod visuals;

@@ -14,6 +14,7 @@ use a2ml::math::{JointVector, Real, UnitQuaternion, Vector3};
 use a2ml::output::{OutputError, topics, write_csv, write_json, write_mcap};
 use a2ml::solve::{
     Fallback, Plan, QpStats, ReferenceSample, ReferenceState, SegmentReport, VariableError,
+    Warning, WarningKind,
 };
 use a2ml::trajectory::{CapsuleDistances, Clearance, Trajectory};
 use serde_json::Value;
@@ -118,7 +119,12 @@ fn plan(robot: &Robot) -> Plan {
         segments: vec![report("reach", 0, 0.0, 0.25), report("back", 1, 0.201, 0.4)],
         wrist_reference,
         safety_distance: 0.02,
-        warnings: vec!["back, segment 1: a warning".into()],
+        warnings: vec![Warning::on_segment(
+            WarningKind::MissedGoal,
+            "back",
+            0,
+            "action `back`, segment 1: a warning".to_owned(),
+        )],
         references,
         reference_ends: ends.iter().map(|q| reference_state(robot, q)).collect(),
         distances: vec![CapsuleDistances {
@@ -207,7 +213,15 @@ fn conforms(value: &Value, schema: &Value, at: &str) -> Result<(), String> {
         }
         "number" => value.is_number(),
         "integer" => value.is_u64() || value.is_i64(),
-        "string" => value.is_string(),
+        "string" => match schema["enum"].as_array() {
+            Some(values) if value.is_string() => {
+                return values
+                    .contains(value)
+                    .then_some(())
+                    .ok_or(format!("{at}: {value} is not one of {values:?}"));
+            }
+            _ => value.is_string(),
+        },
         "boolean" => value.is_boolean(),
         other => return Err(format!("{at}: unexpected schema type {other}")),
     };
@@ -351,7 +365,7 @@ fn the_task_source_and_the_urdf_are_attached_with_the_metadata() {
     assert_eq!(entries["robot"], robot.name);
     assert_eq!(entries["a2ml_version"], env!("CARGO_PKG_VERSION"));
     assert_eq!(entries["rate_hz"].parse::<Real>().expect("a number"), plan.rate);
-    assert_eq!(entries["warnings"], plan.warnings[0]);
+    assert_eq!(entries["warnings"], plan.warnings[0].to_string());
 }
 
 #[test]
@@ -556,17 +570,18 @@ fn each_segment_is_recorded_at_its_start() {
     let (_, _, _, plan, recording) = written("segments", "construct_scene.a2ml");
     let records: Vec<&Value> = recording.messages[topics::SEGMENTS].iter().map(|m| &m.2).collect();
     assert_eq!(records[0]["action"], "reach");
-    assert_eq!(records[0]["action_type"], "II");
-    assert_eq!(records[0]["pattern"], "Goal");
-    assert_eq!(records[0]["space"], "Cpsa");
+    assert_eq!(records[0]["action_type"], "ii");
+    assert_eq!(records[0]["pattern"], "goal");
+    assert_eq!(records[0]["space"], "cpsa");
     assert_eq!(records[0]["solver"], "qp");
-    assert_eq!(records[0]["focus"], serde_json::json!(["Pw", "Ow"]));
+    assert_eq!(records[0]["focus"], serde_json::json!(["pw", "ow"]));
     assert!(records[0].get("clearance").is_none(), "absent, not null");
     assert!(records[1].get("action_type").is_none());
     assert!(records[0].get("rrt").is_none() && records[0].get("fallback").is_none());
-    assert_eq!(records[0]["qp"], serde_json::json!({ "steps": 40, "clarabel_steps": 0 }));
+    let qp = serde_json::json!({ "steps": 40, "clarabel_steps": 0, "clarabel_almost_solved": 0 });
+    assert_eq!(records[0]["qp"], qp);
     assert_eq!(records[1]["clearance"]["obstacle"], "table");
-    assert_eq!(records[1]["path_errors"][0]["variable"], "Swivel");
+    assert_eq!(records[1]["path_errors"][0]["variable"], "swivel");
     assert_eq!(records[1]["start"].as_f64(), Some(plan.segments[1].start));
     assert_eq!(records[1]["reached"], true);
 }
@@ -691,7 +706,9 @@ fn the_csv_holds_every_sample_exactly() {
     for v in ["pw_x", "pw_y", "pw_z", "ow_x", "ow_y", "ow_z", "ow_w", "swivel"] {
         expected.push(format!("ref_{v}"));
     }
-    for v in ["os_x", "os_y", "os_z", "os_w", "elbow"] {
+    for v in
+        ["shoulder_frame_x", "shoulder_frame_y", "shoulder_frame_z", "shoulder_frame_w", "elbow"]
+    {
         expected.push(format!("ref_{v}"));
     }
     expected.push(format!("distance_{}_to_table", robot.capsules[1].name));
@@ -744,7 +761,13 @@ fn the_json_is_the_plan_with_its_origin() {
     let q = &json["trajectory"]["positions"][SAMPLES - 1];
     assert_eq!(q.as_array().map(Vec::len), Some(7));
     assert_eq!(json["segments"][1]["action"], "back");
-    assert_eq!(json["warnings"][0], plan.warnings[0].as_str());
+    let warning = &json["warnings"][0];
+    assert_eq!(warning["kind"], "missed_goal");
+    assert_eq!(
+        (&warning["action"], &warning["segment"]),
+        (&serde_json::json!("back"), &serde_json::json!(0))
+    );
+    assert_eq!(warning["message"], plan.warnings[0].message.as_str());
     let reference = &json["references"][70];
     assert_eq!(reference["segment"], 1);
     let state = &plan.references[70].state;

@@ -143,7 +143,7 @@ fn an_obstacle_across_the_wrist_path_stalls_the_qp_clear_of_it() {
     assert!(!report.reached && report.stalled, "{report:?}");
     assert!(!plan.reached());
     assert!(
-        plan.warnings[0].contains("action `reach`, segment 1: missed Pw"),
+        plan.warnings[0].message.contains("action `reach`, segment 1: missed Pw"),
         "{:?}",
         plan.warnings
     );

@@ -422,7 +422,11 @@ fn an_arm_without_geometry_is_covered_by_its_skeleton_or_refused() {
     let (text, centre, radius) = reach_around_ball(&xarm, file, base, tip, 9);
     let task = a2ml::language::parse(&text, None).expect("task");
     let plan = a2ml::solve::plan(&xarm, &task, &a2ml::solve::PlanOptions::default()).expect("plan");
-    assert!(plan.warnings.iter().any(|w| w.contains("skeleton capsule")), "{:?}", plan.warnings);
+    assert!(
+        plan.warnings.iter().any(|w| w.message.contains("skeleton capsule")),
+        "{:?}",
+        plan.warnings
+    );
     let mut t = plan.trajectory.start();
     while t <= plan.trajectory.end() {
         let q = plan.trajectory.sample(t).0;

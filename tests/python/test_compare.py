@@ -15,7 +15,7 @@ def test_compare_returns_flat_records() -> None:
     assert [r["solver"] for r in records] == ["qp", "qp", "pmp", "pmp", "hamp"]
     pmp = records[2]
     assert pmp["solved_by"] == "pmp" and pmp["action"] == "out_diagonal"
-    assert isinstance(pmp["error_Pw"], float) and pmp["error_Pw"] < 1e-3
-    assert pmp["path_error_Pw"] > records[0]["path_error_Pw"]
+    assert isinstance(pmp["error_pw"], float) and pmp["error_pw"] < 1e-3
+    assert pmp["path_error_pw"] > records[0]["path_error_pw"]
     assert isinstance(pmp["limit_joint"], str) and pmp["planning_time"] > 0.0
     assert records[4]["error"] is not None and "not available yet" in records[4]["error"]

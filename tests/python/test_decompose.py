@@ -63,7 +63,7 @@ def check_shape(d: Decomposition, task: Task) -> None:
         for segment in action["segments"]:
             assert set(segment) == a2ml.PlannedSegment.__required_keys__
             assert segment["space"] in ("cpsa", "hat")
-            assert segment["pattern"] in (1, 2, 3)
+            assert segment["pattern"] in ("path", "goal", "mixed")
             assert segment["duration"] > 0.0
             assert isinstance(segment["duration_raised"], bool)
             for key in ("start", "end"):
@@ -89,14 +89,14 @@ def test_path_by_is_four_type_i_actions() -> None:
     assert [a["name"] for a in d["actions"]] == names
     assert [a["index"] for a in d["actions"]] == [0, 1, 2, 3]
     for action in d["actions"]:
-        assert action["type"] == "I"
+        assert action["type"] == "i"
         assert action["type_number"] == 1
         assert action["description"] == "one path constraint, no goal"
         assert action["goal_space"] is None
         assert action["secondary_goal_space"] is None
         assert action["optimisations"] == []
         (segment,) = action["segments"]
-        assert segment["pattern"] == 1
+        assert segment["pattern"] == "path"
         assert segment["solver"] == "auto"
         assert segment["relaxed"] == []
     swing_out = d["actions"][0]
@@ -114,7 +114,7 @@ def test_type_iv_forward_bar() -> None:
     check_shape(d, task)
     (action,) = d["actions"]
     assert action["name"] == "rise_along_line"
-    assert action["type"] == "IV"
+    assert action["type"] == "iv"
     assert action["type_number"] == 4
     assert action["goal_space"] == "hat"
     assert action["secondary_goal_space"] is None
@@ -126,8 +126,8 @@ def test_type_iv_forward_bar() -> None:
     assert size == pytest.approx(0.40, abs=0.01)
     assert 0.0 <= report["residual"] < 1e-2
     patterns = [s["pattern"] for s in action["segments"]]
-    assert 3 in patterns
-    segment = action["segments"][patterns.index(3)]
+    assert "mixed" in patterns
+    segment = action["segments"][patterns.index("mixed")]
     assert segment["space"] == "cpsa"
     assert segment["solver"] == "rrt"
     (line,) = [p for p in segment["primitives"] if p["kind"] == "path"]
@@ -182,7 +182,7 @@ def test_explicit_actions_have_no_classification() -> None:
     first, second = d["actions"][0]["segments"]
     assert first["duration"] >= 1.0
     assert [s["space"] for s in (first, second)] == ["cpsa", "cpsa"]
-    assert [s["pattern"] for s in (first, second)] == [1, 1]
+    assert [s["pattern"] for s in (first, second)] == ["path", "path"]
     assert first["solver"] == "auto"
     written = task.actions[0]["segments"][0]["primitives"]
     assert [p["variables"] for p in first["primitives"]] == [p["variables"] for p in written]
@@ -263,7 +263,7 @@ def test_bad_robot_file_raises_urdf_error(tmp_path: Path) -> None:
     # The robot argument is used instead of the task's file.
     robot = Robot.from_urdf(TESTS_DIR.parents[1] / "robots" / "coman_right_arm.urdf")
     d = a2ml.decompose(task, robot)
-    assert [a["type"] for a in d["actions"]] == ["I"]
+    assert [a["type"] for a in d["actions"]] == ["i"]
 
 
 def test_wrong_argument_types() -> None:

@@ -179,7 +179,7 @@ def test_explicit_action(task: Task) -> None:
     assert first["space"] == "hat" and first["duration"] == 1.5
     about, reach = first["primitives"]
     assert about == {
-        "variables": ["os"],
+        "variables": ["shoulder_frame"],
         "kind": "path",
         "feature": {"kind": "about", "axis": "-r", "angle": pytest.approx(0.5236, abs=1e-4)},
     }

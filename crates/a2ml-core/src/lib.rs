@@ -19,6 +19,7 @@ pub mod output;
 pub mod profile;
 pub mod robot;
 pub mod solve;
+pub mod spelling;
 pub mod trajectory;
 
 pub use error::Error;

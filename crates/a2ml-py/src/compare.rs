@@ -1,7 +1,7 @@
 //! `a2ml.compare`: one task planned by several solvers, as a list of flat records (dicts)
 //! that `pandas.DataFrame` takes as they are: one per solver and segment, or one carrying
 //! the error of a solver that produced no plan. Goal and path errors are flattened into
-//! `error_<variable>` and `path_error_<variable>` keys (ASCII names: Pw, Ow, sw, Os, e).
+//! `error_<variable>` and `path_error_<variable>` keys (pw, ow, swivel, shoulder_frame, elbow).
 
 use a2ml_core::language::SolverChoice;
 use a2ml_core::solve::PlanOptions;

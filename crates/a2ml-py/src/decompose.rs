@@ -62,7 +62,7 @@ fn action<'py>(py: Python<'py>, a: &PlannedAction) -> PyResult<Dict<'py>> {
     d.set_item("index", a.index)?;
     d.set_item("name", &a.name)?;
     let c: Option<&Classification> = a.classification.as_ref();
-    d.set_item("type", c.map(|c| c.action_type.numeral()))?;
+    d.set_item("type", c.map(|c| c.action_type.as_str()))?;
     d.set_item("type_number", c.map(|c| c.action_type.number()))?;
     d.set_item("description", c.map(|c| c.action_type.description()))?;
     d.set_item("goal_space", c.and_then(|c| c.goal_space).map(space_name))?;
@@ -80,10 +80,10 @@ fn action<'py>(py: Python<'py>, a: &PlannedAction) -> PyResult<Dict<'py>> {
 fn segment<'py>(py: Python<'py>, s: &PlannedSegment) -> PyResult<Dict<'py>> {
     let d = PyDict::new(py);
     d.set_item("space", space_name(s.space))?;
-    d.set_item("pattern", s.pattern.number())?;
+    d.set_item("pattern", s.pattern.as_str())?;
     d.set_item("duration", s.duration)?;
     d.set_item("duration_raised", s.duration_raised)?;
-    d.set_item("solver", s.solver.name())?;
+    d.set_item("solver", s.solver.as_str())?;
     d.set_item("relaxed", variable_names(&s.relaxed))?;
     d.set_item("start", to_vector(py, s.start.as_slice()))?;
     d.set_item("end", to_vector(py, s.end.as_slice()))?;

@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use a2ml_core::language::{
     self, Action, ActionBody, Axis, BodyAxis, Goal, GoalConstraint, Obstacle, PathConstraint,
     PathFeature, PathItem, PositionFrame, Primitive, PrimitiveConstraint, Segment, Settings, Shape,
-    Space, Start, Target, Variable,
+    SolverChoice, Space, Start, Target, Variable,
 };
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -121,7 +121,7 @@ impl PyTask {
     }
 
     /// A new task, this one with the goal values of `action` replaced: keyword arguments
-    /// named as the `Robot` methods name variables (`pw`: (3,) position in m; `ow`, `os`:
+    /// named by the variables' spellings (`pw`: (3,) position in m; `ow`, `shoulder_frame`:
     /// (3, 3) rotations; `swivel`, `elbow`: angles in rad), in the task's frame. Only a goal
     /// the action states can change. The new task is the old text with those values, printed
     /// canonically, validated; it pickles and is attached to outputs as any task.
@@ -138,7 +138,8 @@ impl PyTask {
             let variable = variable_from_name(&name).ok_or_else(|| {
                 PyTypeError::new_err(format!(
                     "with_goal() got an unexpected keyword argument '{name}' \
-                     (variables: pw, ow, swivel, os, elbow)"
+                     (variables: {})",
+                    a2ml_core::spelling::spellings::<Variable>().join(", ")
                 ))
             })?;
             let target = match variable {
@@ -205,37 +206,22 @@ pub(crate) fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyTask> {
     Ok(PyTask { task, source, path: Some(path) })
 }
 
-/// The Python spelling of a variable: the argument names of `Robot.ik_cpsa`
-/// and `Robot.ik_hat`.
+/// The Python spelling of a variable: its one spelling ([`Variable::as_str`]).
 pub(crate) fn variable_name(v: Variable) -> &'static str {
-    match v {
-        Variable::Pw => "pw",
-        Variable::Ow => "ow",
-        Variable::Swivel => "swivel",
-        Variable::Os => "os",
-        Variable::Elbow => "elbow",
-    }
+    v.as_str()
 }
 
 pub(crate) fn variable_names(vs: &[Variable]) -> Vec<&'static str> {
     vs.iter().copied().map(variable_name).collect()
 }
 
-/// The variable spelled `name` as [`variable_name`] spells it.
+/// The variable spelled `name`.
 pub(crate) fn variable_from_name(name: &str) -> Option<Variable> {
-    Variable::ALL.into_iter().find(|v| variable_name(*v) == name)
+    name.parse().ok()
 }
 
 pub(crate) fn space_name(s: Space) -> &'static str {
-    match s {
-        Space::Cpsa => "cpsa",
-        Space::Hat => "hat",
-    }
-}
-
-/// The space spelled `name` as [`space_name`] spells it.
-pub(crate) fn space_from_name(name: &str) -> Option<Space> {
-    [Space::Cpsa, Space::Hat].into_iter().find(|s| space_name(*s) == name)
+    s.as_str()
 }
 
 /// (3,) array (m), (3, 3) array or float (rad).
@@ -316,7 +302,7 @@ fn obstacle<'py>(py: Python<'py>, o: &Obstacle) -> PyResult<Dict<'py>> {
 fn settings<'py>(py: Python<'py>, s: &Settings) -> PyResult<Dict<'py>> {
     let d = PyDict::new(py);
     d.set_item("rate", s.rate)?;
-    d.set_item("solver", s.solver.name())?;
+    d.set_item("solver", s.solver.as_str())?;
     d.set_item("seed", s.seed)?;
     d.set_item("transition", s.transition)?;
     d.set_item(
@@ -425,7 +411,7 @@ fn action<'py>(py: Python<'py>, a: &Action) -> PyResult<Dict<'py>> {
     d.set_item("add", &a.add)?;
     d.set_item("del", &a.del)?;
     d.set_item("contact", &a.contact)?;
-    d.set_item("solver", a.solver.map(|s| s.name()))?;
+    d.set_item("solver", a.solver.map(SolverChoice::as_str))?;
     match &a.body {
         ActionBody::Constraints { goal, path, duration } => {
             d.set_item("kind", "constraints")?;

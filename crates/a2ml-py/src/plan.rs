@@ -2,32 +2,31 @@
 //! trajectory at the output rate, what each segment did, and the writers of docs/design.md §6.
 //!
 //! Arrays are float64: `t` (N,) s, `q` and `qd` (N, 7) rad and rad/s, the wrist reference
-//! (M, 4) as t, x, y, z (s, m in {b}). Reports are spelled as [`crate::decompose`] spells
-//! segments; their small records are the NamedTuples of `a2ml._types`. A plan keeps its
-//! `Robot` and `Task` (whose source MCAP attaches) and pickles as its data, rebuilt here,
-//! because the core types serialize but do not deserialize.
+//! (M, 4) as t, x, y, z (s, m in {b}). Every enum value is spelled as the core spells it
+//! (`as_str`, the serde name; docs/cli.md lists them); the small records are the NamedTuples of
+//! `a2ml._types`, filled by field name from the core's serde representation. A plan keeps its
+//! `Robot` and `Task` (whose source MCAP attaches) and pickles as its JSON, which the core
+//! reads back, with the wall-clock timings that plan files leave out.
 
 use std::borrow::Cow;
 use std::collections::HashMap;
 use std::path::PathBuf;
 
-use a2ml_core::decompose::{ActionType, SegmentPattern};
 use a2ml_core::language::SolverChoice;
-use a2ml_core::math::{DOF, JointVector, Real, Vector3};
+use a2ml_core::math::{DOF, JointVector, Real};
 use a2ml_core::output;
-use a2ml_core::solve::rrt::RrtStats;
-use a2ml_core::solve::{self, Fallback, Plan, PlanOptions, QpStats, SegmentReport, VariableError};
-use a2ml_core::trajectory::{Clearance, Trajectory};
+use a2ml_core::solve::{self, Plan, PlanOptions, SegmentReport, VariableError};
 use numpy::IntoPyArray;
 use numpy::ndarray::Array2;
-use pyo3::call::PyCallArgs;
-use pyo3::exceptions::{PyKeyError, PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyString, PyTuple, PyType};
 use rayon::prelude::*;
+use serde::Serialize;
+use serde::de::DeserializeOwned;
 
-use crate::language::{self, PyTask, space_from_name, space_name, variable_from_name};
-use crate::{CoreError, Matrix, PyRobot, Vector, read_array, to_vector};
+use crate::language::{self, PyTask};
+use crate::{CoreError, Matrix, PyRobot, Vector, to_vector};
 
 type Dict<'py> = Bound<'py, PyDict>;
 
@@ -186,10 +185,8 @@ pub(crate) fn task_path(value: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
 }
 
 pub(crate) fn solver_choice(name: &str) -> PyResult<SolverChoice> {
-    SolverChoice::NAMES.iter().find(|(n, _)| *n == name).map(|(_, s)| *s).ok_or_else(|| {
-        let names: Vec<&str> = SolverChoice::NAMES.iter().map(|(n, _)| *n).collect();
-        PyValueError::new_err(format!("unknown solver '{name}' ({})", names.join(", ")))
-    })
+    name.parse()
+        .map_err(|e: a2ml_core::spelling::UnknownSpelling| PyValueError::new_err(e.to_string()))
 }
 
 /// A planned task: the joint trajectory at the output rate and one report per segment;
@@ -245,10 +242,11 @@ impl PyPlan {
         self.plan.segments.iter().map(|r| PySegmentReport { report: r.clone() }).collect()
     }
 
-    /// Goals missed beyond tolerance, each naming its action and segment.
+    /// Goals missed, fallbacks and repairs: `PlanWarning(kind, action, segment, message)`
+    /// each, `str()` its message.
     #[getter]
-    fn warnings(&self) -> Vec<String> {
-        self.plan.warnings.clone()
+    fn warnings<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyAny>>> {
+        self.plan.warnings.iter().map(|w| record(py, "PlanWarning", w, None)).collect()
     }
 
     /// Whether every segment reached its goals within tolerance.
@@ -388,63 +386,39 @@ impl PyPlan {
         crate::plot::notebook(py, robot, task, &self.plan)
     }
 
-    /// Pickles as `Plan._from_state(robot, task, state)`.
+    /// Pickles as `Plan._from_json(robot, task, json, timings)`: the plan as the core
+    /// serialises it, and each segment's wall-clock timings, which plan files leave out.
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
         let py = slf.py();
         let this = slf.get();
-        let state = PyDict::new(py);
-        state.set_item("task", &this.plan.task)?;
-        state.set_item("joint_names", this.joint_names())?;
-        state.set_item("rate", this.plan.rate)?;
-        state.set_item("t", this.t(py))?;
-        state.set_item("q", this.q(py))?;
-        state.set_item("qd", this.qd(py))?;
-        state.set_item("segments", this.segments())?;
-        state.set_item("wrist_reference", this.wrist_reference(py))?;
-        state.set_item("safety_distance", this.plan.safety_distance)?;
-        state.set_item("warnings", this.warnings())?;
-        state.set_item("per_sample", crate::plot::per_sample_state(&this.plan)?)?;
-        let rebuild = slf.get_type().getattr("_from_state")?;
-        let args = (this.robot.clone_ref(py), this.task.clone_ref(py), state).into_pyobject(py)?;
+        let json = to_json(&this.plan)?;
+        let timings: Vec<Timings> = this.plan.segments.iter().map(timings).collect();
+        let rebuild = slf.get_type().getattr("_from_json")?;
+        let args =
+            (this.robot.clone_ref(py), this.task.clone_ref(py), json, timings).into_pyobject(py)?;
         PyTuple::new(py, [rebuild, args.into_any()])
     }
 
     /// The inverse of `__reduce__`.
     #[classmethod]
-    fn _from_state(
+    fn _from_json(
         _cls: &Bound<'_, PyType>,
         robot: Py<PyRobot>,
         task: Py<PyTask>,
-        state: &Bound<'_, PyDict>,
+        json: &str,
+        timings: Vec<Timings>,
     ) -> PyResult<Self> {
-        let t = item(state, "t")?;
-        let samples = t.len()?;
-        let times = read_array(&t, "t", &[samples])?;
-        let positions = read_joint_rows(&item(state, "q")?, "q", samples)?;
-        let velocities = read_joint_rows(&item(state, "qd")?, "qd", samples)?;
-        let trajectory = Trajectory::new(times, positions, velocities)
-            .map_err(|e| PyValueError::new_err(format!("invalid plan trajectory: {e}")))?;
-        let reference = item(state, "wrist_reference")?;
-        let rows = reference.len()?;
-        let wrist_reference = read_array(&reference, "wrist_reference", &[rows, 4])?
-            .chunks_exact(4)
-            .map(|r| (r[0], Vector3::new(r[1], r[2], r[3])))
-            .collect();
-        let segments: Vec<Bound<'_, PySegmentReport>> = item(state, "segments")?.extract()?;
-        let plan = Plan {
-            task: item(state, "task")?.extract()?,
-            joint_names: item(state, "joint_names")?.extract()?,
-            rate: item(state, "rate")?.extract()?,
-            trajectory,
-            segments: segments.iter().map(|s| s.get().report.clone()).collect(),
-            wrist_reference,
-            safety_distance: item(state, "safety_distance")?.extract()?,
-            warnings: item(state, "warnings")?.extract()?,
-            references: Vec::new(),
-            reference_ends: Vec::new(),
-            distances: Vec::new(),
-        };
-        let plan = crate::plot::with_per_sample_state(plan, &item(state, "per_sample")?)?;
+        let mut plan: Plan = from_json(json, "plan")?;
+        if timings.len() != plan.segments.len() {
+            return Err(PyValueError::new_err(format!(
+                "invalid plan state: {} timings for {} segments",
+                timings.len(),
+                plan.segments.len()
+            )));
+        }
+        for (report, t) in plan.segments.iter_mut().zip(timings) {
+            with_timings(report, t);
+        }
         Ok(Self { plan, robot, task })
     }
 
@@ -465,27 +439,55 @@ pub(crate) fn joint_rows<'py>(py: Python<'py>, rows: &[JointVector]) -> Matrix<'
     Array2::from_shape_fn((rows.len(), DOF), |(i, j)| rows[i][j]).into_pyarray(py)
 }
 
-fn read_joint_rows(
-    value: &Bound<'_, PyAny>,
-    name: &str,
-    samples: usize,
-) -> PyResult<Vec<JointVector>> {
-    let values = read_array(value, name, &[samples, DOF])?;
-    Ok(values.chunks_exact(DOF).map(JointVector::from_row_slice).collect())
+/// `value` as the core serialises it.
+fn to_json<T: Serialize>(value: &T) -> PyResult<String> {
+    serde_json::to_string(value)
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot serialise (a bug in a2ml): {e}")))
 }
 
-/// `state[key]`, or a KeyError naming the key.
-fn item<'py>(state: &Bound<'py, PyDict>, key: &str) -> PyResult<Bound<'py, PyAny>> {
-    state.get_item(key)?.ok_or_else(|| PyKeyError::new_err(key.to_owned()))
+/// A `what` read back from the core's serialisation, or a ValueError saying why not.
+fn from_json<T: DeserializeOwned>(json: &str, what: &str) -> PyResult<T> {
+    serde_json::from_str(json).map_err(|e| PyValueError::new_err(format!("invalid {what}: {e}")))
 }
 
-/// One of the NamedTuples of `a2ml._types`.
-fn record<'py>(
+/// `value`'s serde representation as Python objects (dicts, lists, str, float, int, None).
+fn to_python<'py, T: Serialize>(py: Python<'py>, value: &T) -> PyResult<Bound<'py, PyAny>> {
+    py.import("json")?.getattr("loads")?.call1((to_json(value)?,))
+}
+
+/// The NamedTuple `name` of `a2ml._types` with `value`'s serialised fields, by name, and
+/// `extra` ones (the wall-clock timings the serialisation leaves out).
+fn record<'py, T: Serialize>(
     py: Python<'py>,
     name: &str,
-    fields: impl PyCallArgs<'py>,
+    value: &T,
+    extra: Option<Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    py.import("a2ml._types")?.getattr(name)?.call1(fields)
+    let fields = to_python(py, value)?.cast_into::<PyDict>()?;
+    if let Some(extra) = extra {
+        fields.update(extra.as_mapping())?;
+    }
+    py.import("a2ml._types")?.getattr(name)?.call((), Some(&fields))
+}
+
+/// A segment's wall-clock timings, which plan files leave out: the QP's mean, worst, median
+/// fast and median Clarabel step (s), and the RRT's time when it ran.
+type Timings = (Real, Real, Real, Real, Option<Real>);
+
+fn timings(report: &SegmentReport) -> Timings {
+    let q = &report.qp;
+    let rrt = report.rrt.as_ref().map(|r| r.time);
+    (q.mean_step_time, q.worst_step_time, q.median_fast_time, q.median_clarabel_time, rrt)
+}
+
+fn with_timings(report: &mut SegmentReport, (mean, worst, fast, clarabel, rrt): Timings) {
+    report.qp.mean_step_time = mean;
+    report.qp.worst_step_time = worst;
+    report.qp.median_fast_time = fast;
+    report.qp.median_clarabel_time = clarabel;
+    if let (Some(stats), Some(time)) = (report.rrt.as_mut(), rrt) {
+        stats.time = time;
+    }
 }
 
 /// What one movement segment did; immutable, equal when every field is.
@@ -514,28 +516,28 @@ impl PySegmentReport {
         self.report.segment
     }
 
-    /// "I" to "VII", or None for an action written as explicit segments.
+    /// The paper's type, "i" to "vii", or None for an action written as explicit segments.
     #[getter]
     fn action_type(&self) -> Option<&'static str> {
-        self.report.action_type.map(ActionType::numeral)
+        self.report.action_type.map(|t| t.as_str())
     }
 
     /// "cpsa" or "hat".
     #[getter]
     fn space(&self) -> &'static str {
-        space_name(self.report.space)
+        self.report.space.as_str()
     }
 
-    /// 1 (paths), 2 (goals) or 3 (both).
+    /// The paper's pattern: "path" (1), "goal" (2) or "mixed" (3).
     #[getter]
-    fn pattern(&self) -> u8 {
-        self.report.pattern.number()
+    fn pattern(&self) -> &'static str {
+        self.report.pattern.as_str()
     }
 
     /// The solver that produced the motion.
     #[getter]
     fn solver(&self) -> &'static str {
-        self.report.solver.name()
+        self.report.solver.as_str()
     }
 
     /// The focus of interest: the variables of the featured primitive.
@@ -596,7 +598,7 @@ impl PySegmentReport {
     /// "qp_left_path", or None.
     #[getter]
     fn fallback(&self) -> Option<&'static str> {
-        self.report.fallback.map(Fallback::key)
+        self.report.fallback.map(|f| f.as_str())
     }
 
     /// The largest |q'| / velocity limit of any joint over the segment's time in the output.
@@ -644,14 +646,7 @@ impl PySegmentReport {
     /// The smallest clearance over the segment, or None.
     #[getter]
     fn clearance<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
-        self.report
-            .clearance
-            .as_ref()
-            .map(|c| {
-                let fields = (c.distance, c.time, c.link.as_str(), c.obstacle.as_str());
-                record(py, "Clearance", fields)
-            })
-            .transpose()
+        self.report.clearance.as_ref().map(|c| record(py, "Clearance", c, None)).transpose()
     }
 
     /// Smallest distance of any joint to its limits over the segment (rad).
@@ -676,15 +671,12 @@ impl PySegmentReport {
     #[getter]
     fn qp<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let s = &self.report.qp;
-        let fields = (
-            s.steps,
-            s.clarabel_steps,
-            s.mean_step_time,
-            s.worst_step_time,
-            s.median_fast_time,
-            s.median_clarabel_time,
-        );
-        record(py, "QpStats", fields)
+        let times = PyDict::new(py);
+        times.set_item("mean_step_time", s.mean_step_time)?;
+        times.set_item("worst_step_time", s.worst_step_time)?;
+        times.set_item("median_fast_time", s.median_fast_time)?;
+        times.set_item("median_clarabel_time", s.median_clarabel_time)?;
+        record(py, "QpStats", s, Some(times))
     }
 
     /// RRT counters when the RRT solved the segment.
@@ -693,7 +685,11 @@ impl PySegmentReport {
         self.report
             .rrt
             .as_ref()
-            .map(|s| record(py, "RrtStats", (s.samples, s.nodes, s.collision_checks, s.time)))
+            .map(|s| {
+                let time = PyDict::new(py);
+                time.set_item("time", s.time)?;
+                record(py, "RrtStats", s, Some(time))
+            })
             .transpose()
     }
 
@@ -733,79 +729,20 @@ impl PySegmentReport {
         Ok(d)
     }
 
-    /// Pickles as `SegmentReport._from_dict(to_dict())`.
+    /// Pickles as `SegmentReport._from_json(json, timings)`, as a plan does.
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
         let py = slf.py();
-        let rebuild = slf.get_type().getattr("_from_dict")?;
-        let args = (slf.get().to_dict(py)?,).into_pyobject(py)?;
+        let report = &slf.get().report;
+        let rebuild = slf.get_type().getattr("_from_json")?;
+        let args = (to_json(report)?, timings(report)).into_pyobject(py)?;
         PyTuple::new(py, [rebuild, args.into_any()])
     }
 
-    /// The inverse of `to_dict`.
+    /// The inverse of `__reduce__`.
     #[classmethod]
-    fn _from_dict(_cls: &Bound<'_, PyType>, d: &Bound<'_, PyDict>) -> PyResult<Self> {
-        let action_type: Option<String> = item(d, "action_type")?.extract()?;
-        let space: String = item(d, "space")?.extract()?;
-        let solver: String = item(d, "solver")?.extract()?;
-        let focus: Vec<String> = item(d, "focus")?.extract()?;
-        let clearance: Option<(Real, Real, String, String)> = item(d, "clearance")?.extract()?;
-        let qp: (usize, usize, Real, Real, Real, Real) = item(d, "qp")?.extract()?;
-        let rrt: Option<(usize, usize, usize, Real)> = item(d, "rrt")?.extract()?;
-        let fallback: Option<String> = item(d, "fallback")?.extract()?;
-        let report = SegmentReport {
-            action: item(d, "action")?.extract()?,
-            action_index: item(d, "action_index")?.extract()?,
-            segment: item(d, "segment")?.extract()?,
-            action_type: action_type.as_deref().map(action_type_from_numeral).transpose()?,
-            space: space_from_name(&space).ok_or_else(|| unknown("space", &space))?,
-            pattern: pattern_from_number(item(d, "pattern")?.extract()?)?,
-            solver: solver_choice(&solver)?,
-            focus: focus.iter().map(|v| variable(v)).collect::<PyResult<_>>()?,
-            start: item(d, "start")?.extract()?,
-            end: item(d, "end")?.extract()?,
-            duration: item(d, "duration")?.extract()?,
-            settle: item(d, "settle")?.extract()?,
-            errors: read_variable_errors(&item(d, "errors")?)?,
-            path_errors: read_variable_errors(&item(d, "path_errors")?)?,
-            hard_path: item(d, "hard_path")?.extract()?,
-            path_kept: item(d, "path_kept")?.extract()?,
-            clearance: clearance.map(|(distance, time, link, obstacle)| Clearance {
-                distance,
-                time,
-                link,
-                obstacle,
-            }),
-            limit_margin: item(d, "limit_margin")?.extract()?,
-            stalled: item(d, "stalled")?.extract()?,
-            reached: item(d, "reached")?.extract()?,
-            qp: QpStats {
-                steps: qp.0,
-                clarabel_steps: qp.1,
-                mean_step_time: qp.2,
-                worst_step_time: qp.3,
-                median_fast_time: qp.4,
-                median_clarabel_time: qp.5,
-            },
-            rrt: rrt.map(|(samples, nodes, collision_checks, time)| RrtStats {
-                samples,
-                nodes,
-                collision_checks,
-                time,
-            }),
-            fallback: fallback
-                .map(|name| {
-                    let found = Fallback::ALL.into_iter().find(|f| f.key() == name);
-                    found.ok_or_else(|| unknown("fallback", &name))
-                })
-                .transpose()?,
-            peak_velocity_ratio: item(d, "peak_velocity_ratio")?.extract()?,
-            peak_acceleration_ratio: item(d, "peak_acceleration_ratio")?.extract()?,
-            limits_kept: item(d, "limits_kept")?.extract()?,
-            slowed_down: item(d, "slowed_down")?.extract()?,
-            joint_jerk: item(d, "joint_jerk")?.extract()?,
-            wrist_jerk: item(d, "wrist_jerk")?.extract()?,
-            speed_peaks: item(d, "speed_peaks")?.extract()?,
-        };
+    fn _from_json(_cls: &Bound<'_, PyType>, json: &str, timings: Timings) -> PyResult<Self> {
+        let mut report: SegmentReport = from_json(json, "segment report")?;
+        with_timings(&mut report, timings);
         Ok(Self { report })
     }
 
@@ -825,48 +762,11 @@ impl PySegmentReport {
     }
 }
 
-/// `{variable: VariableError(error, within)}` in the space's order.
+/// `{variable: VariableError(variable, error, within)}` in the space's order.
 fn variable_errors<'py>(py: Python<'py>, errors: &[VariableError]) -> PyResult<Dict<'py>> {
     let d = PyDict::new(py);
     for e in errors {
-        d.set_item(
-            language::variable_name(e.variable),
-            record(py, "VariableError", (e.error, e.within))?,
-        )?;
+        d.set_item(e.variable.as_str(), record(py, "VariableError", e, None)?)?;
     }
     Ok(d)
-}
-
-fn read_variable_errors(value: &Bound<'_, PyAny>) -> PyResult<Vec<VariableError>> {
-    let d = value.cast::<PyDict>()?;
-    d.iter()
-        .map(|(name, e)| {
-            let (error, within): (Real, bool) = e.extract()?;
-            Ok(VariableError { variable: variable(&name.extract::<String>()?)?, error, within })
-        })
-        .collect()
-}
-
-fn variable(name: &str) -> PyResult<a2ml_core::language::Variable> {
-    variable_from_name(name).ok_or_else(|| unknown("variable", name))
-}
-
-fn action_type_from_numeral(numeral: &str) -> PyResult<ActionType> {
-    ActionType::ALL
-        .into_iter()
-        .find(|t| t.numeral() == numeral)
-        .ok_or_else(|| unknown("action type", numeral))
-}
-
-fn pattern_from_number(number: u8) -> PyResult<SegmentPattern> {
-    match number {
-        1 => Ok(SegmentPattern::Path),
-        2 => Ok(SegmentPattern::Goal),
-        3 => Ok(SegmentPattern::Mixed),
-        _ => Err(unknown("segment pattern", &number.to_string())),
-    }
-}
-
-fn unknown(what: &str, value: &str) -> PyErr {
-    PyValueError::new_err(format!("unknown {what} '{value}'"))
 }

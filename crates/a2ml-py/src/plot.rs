@@ -91,23 +91,6 @@ pub(crate) fn notebook(
     py.detach(|| report::notebook_html(robot, task, plan)).map_err(refused)
 }
 
-/// The plan's per-sample references and distances, as JSON text for pickling.
-pub(crate) fn per_sample_state(plan: &Plan) -> PyResult<String> {
-    let parts = (&plan.references, &plan.reference_ends, &plan.distances);
-    serde_json::to_string(&parts).map_err(refused)
-}
-
-/// `plan` with the references and distances of [`per_sample_state`]'s text.
-pub(crate) fn with_per_sample_state(mut plan: Plan, state: &Bound<'_, PyAny>) -> PyResult<Plan> {
-    let text: String = state.extract()?;
-    let (references, reference_ends, distances) = serde_json::from_str(&text)
-        .map_err(|e| PyValueError::new_err(format!("invalid plan state: {e}")))?;
-    plan.references = references;
-    plan.reference_ends = reference_ends;
-    plan.distances = distances;
-    Ok(plan)
-}
-
 /// [`Plan::references`] as arrays, NaN where undefined.
 pub(crate) fn references<'py>(py: Python<'py>, plan: &Plan) -> PyResult<Bound<'py, PyDict>> {
     let samples = &plan.references;

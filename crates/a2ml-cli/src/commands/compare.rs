@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use clap::Args;
 
 use a2ml_core::RobotOptions;
-use a2ml_core::language::SolverChoice;
+use a2ml_core::language::{SolverChoice, Variable};
 use a2ml_core::output as files;
 use a2ml_core::solve::compare::{ComparisonRecord, compare, records};
 use a2ml_core::solve::{PlanOptions, Tolerance};
@@ -114,8 +114,8 @@ fn table(rows: &[ComparisonRecord], tolerance: &Tolerance) -> String {
             .errors
             .iter()
             .map(|(v, e)| {
-                if v == "Pw" {
-                    format!("Pw {} mm", num(e * 1e3, 1))
+                if v == Variable::Pw.as_str() {
+                    format!("{v} {} mm", num(e * 1e3, 1))
                 } else {
                     format!("{v} {}°", num(deg(*e), 2))
                 }

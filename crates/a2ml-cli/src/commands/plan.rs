@@ -177,7 +177,7 @@ fn run_one(args: &PlanArgs, file: &Path, temporaries: &Temporaries) -> Result<()
     let planning_time = started.elapsed();
 
     for warning in &plan.warnings {
-        output::warn(warning);
+        output::warn(&warning.to_string());
     }
     let tolerance = planning.options.tolerance;
     output::print(&summary(file, &planning.robot, &plan, &tolerance, planning_time))?;
@@ -454,17 +454,17 @@ fn summary(
         "limit margin (°)",
         "status",
     ])
-    .left_aligned([2, 4, 5, 7, 10]);
+    .left_aligned([2, 3, 4, 5, 7, 10]);
     table.title("segments");
     for s in &plan.segments {
         table.row(
             s.action.clone(),
             [
                 (s.segment + 1).to_string(),
-                s.action_type.map_or_else(|| "-".to_owned(), |t| t.numeral().to_owned()),
-                s.pattern.number().to_string(),
-                s.space.name().to_owned(),
-                s.solver.name().to_owned(),
+                s.action_type.map_or_else(|| "-".to_owned(), |t| t.to_string()),
+                s.pattern.to_string(),
+                s.space.to_string(),
+                s.solver.to_string(),
                 num(s.end - s.start, SECONDS),
                 goal_error(s, tolerance),
                 s.clearance.as_ref().map_or_else(|| "-".to_owned(), |c| num(c.distance * 1e3, 1)),
@@ -492,7 +492,7 @@ fn summary(
 }
 
 /// The error of the variable furthest from its goal relative to its
-/// tolerance, as `Pw 0.42 mm` or `θsw 0.31°`; `-` for a segment without one.
+/// tolerance, as `pw 0.42 mm` or `swivel 0.31°`; `-` for a segment without one.
 fn goal_error(s: &SegmentReport, tolerance: &Tolerance) -> String {
     let limit = |v: Variable| tolerance.of(v);
     let worst = s
@@ -500,15 +500,17 @@ fn goal_error(s: &SegmentReport, tolerance: &Tolerance) -> String {
         .iter()
         .max_by(|a, b| (a.error / limit(a.variable)).total_cmp(&(b.error / limit(b.variable))));
     match worst {
-        Some(e) if e.variable == Variable::Pw => format!("Pw {} mm", num(e.error * 1e3, 2)),
-        Some(e) => format!("{} {}°", e.variable.symbol(), num(deg(e.error), 2)),
+        Some(e) if e.variable == Variable::Pw => {
+            format!("{} {} mm", e.variable, num(e.error * 1e3, 2))
+        }
+        Some(e) => format!("{} {}°", e.variable, num(deg(e.error), 2)),
         None => "-".to_owned(),
     }
 }
 
 /// `ok`, `stalled` (stopped making progress short of the goal), `missed`
 /// (the time ran out short of it) or `off path` (a hard path left); after
-/// `auto` went on from the QP, why: `ok (qp stalled)`.
+/// `auto` went on from the QP, why: `ok (qp_stalled)`.
 fn status(s: &SegmentReport) -> String {
     let outcome = match (s.path_kept, s.reached, s.stalled) {
         _ if !s.limits_kept => "over limits",
@@ -518,7 +520,7 @@ fn status(s: &SegmentReport) -> String {
         (true, false, false) => "missed",
     };
     match s.fallback {
-        Some(why) => format!("{outcome} ({})", why.name()),
+        Some(why) => format!("{outcome} ({why})"),
         None => outcome.to_owned(),
     }
 }
@@ -546,7 +548,7 @@ fn short(x: Real) -> String {
 #[cfg(test)]
 mod tests {
     use a2ml_core::decompose::SegmentPattern;
-    use a2ml_core::solve::qp::QpError;
+    use a2ml_core::solve::qp::{ClarabelStatus, QpError};
 
     use super::*;
 
@@ -566,13 +568,13 @@ mod tests {
         let failed = SolveError::Qp {
             action: "reach".to_owned(),
             segment: 1,
-            source: QpError::Unsolved { time: 0.25, status: "PrimalInfeasible".to_owned() },
+            source: QpError::Unsolved { time: 0.25, status: ClarabelStatus::PrimalInfeasible },
         };
         let error = solve_error(file, failed);
         assert_eq!(
             error.to_string(),
             "task.a2ml: action `reach`, segment 2: at t = 0.250 s the QP has no solution \
-             (Clarabel: PrimalInfeasible)"
+             (Clarabel: primal_infeasible)"
         );
         assert!(matches!(error, CliError::Planning(_)));
         let unsupported = SolveError::UnsupportedSolver {

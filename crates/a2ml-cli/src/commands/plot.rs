@@ -82,7 +82,7 @@ pub fn plan_file(file: &Path, seed: Option<u64>) -> Result<Planned, CliError> {
     let plan = solve::plan(&robot, &task, &PlanOptions::default())
         .map_err(|e| super::plan::solve_error(file, e))?;
     for warning in &plan.warnings {
-        output::warn(warning);
+        output::warn(&warning.to_string());
     }
     Ok(Planned { robot, task, source, plan })
 }

@@ -23,7 +23,7 @@ fn compare_prints_one_row_per_solver_and_segment_and_writes_each_plan() {
     assert_eq!(records.len(), 3);
     assert_eq!(records[0]["solver"], "pmp");
     assert_eq!(records[0]["solved_by"], "pmp");
-    assert!(records[0]["errors"]["Pw"].as_f64().expect("Pw error") < 1e-3);
+    assert!(records[0]["errors"]["pw"].as_f64().expect("pw error") < 1e-3);
     assert!(records[0]["limit_joint"].is_string() && records[0]["peak_speed_ratio"].is_number());
     assert!(
         records[2]["error"].as_str().expect("hamp fails on a path").contains("not available yet")

@@ -66,9 +66,9 @@ fn writes_mcap_csv_and_json() {
     let rows = rows(&text);
     assert_eq!(rows.len(), 3, "{text}");
     let row: Vec<&str> = rows[2].split_whitespace().collect();
-    assert_eq!(&row[..6], ["rise_towards_elbow_goal", "1", "IV", "3", "CPSA", "qp"], "{text}");
+    assert_eq!(&row[..6], ["rise_towards_elbow_goal", "1", "iv", "mixed", "cpsa", "qp"], "{text}");
     assert_eq!(row.last(), Some(&"ok"), "{text}");
-    assert!(rows[0].starts_with("  slide_left ") && rows[0].contains(" I "), "{text}");
+    assert!(rows[0].starts_with("  slide_left ") && rows[0].contains(" i "), "{text}");
     let total = text.lines().find(|l| l.starts_with("total  ")).expect("a total line");
     assert!(total.contains(" s of motion, ") && total.contains(" at 100 Hz, planned in "));
     assert!(total.contains(" QP steps (") && total.ends_with("%)"), "{total}");
@@ -164,7 +164,7 @@ fn blocked_goal_exits_3_with_the_files_written() {
     let text = stdout(&output);
     let rows = rows(&text);
     assert_eq!(rows.len(), 1, "{text}");
-    assert!(rows[0].contains(" Pw ") && rows[0].ends_with("  stalled"), "{text}");
+    assert!(rows[0].contains(" pw ") && rows[0].ends_with("  stalled"), "{text}");
     assert!(fs::read(&mcap).expect("MCAP written").starts_with(MCAP_MAGIC));
     let plan: Value =
         serde_json::from_str(&fs::read_to_string(&json).expect("JSON")).expect("JSON");

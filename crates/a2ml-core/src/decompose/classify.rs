@@ -31,9 +31,14 @@ use crate::language::{
     Action, ActionBody, Goal, GoalConstraint, PathConstraint, PathFeature, Primitive,
     PrimitiveConstraint, Space, Variable,
 };
+use crate::spelling::spelled;
 
 /// The paper's action types (fig. 3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
+// The numeral in lower case (`iv`): snake_case would split it at every capital (`i_v`).
+#[serde(rename_all = "lowercase")]
 pub enum ActionType {
     /// One path, no goal.
     I,
@@ -68,7 +73,8 @@ impl ActionType {
         self as u8 + 1
     }
 
-    /// The roman numeral.
+    /// The roman numeral, as the paper writes it in prose ("type IV"); the value is spelled
+    /// [`Self::as_str`] (`iv`).
     pub fn numeral(self) -> &'static str {
         ["I", "II", "III", "IV", "V", "VI", "VII"][self as usize]
     }
@@ -87,11 +93,19 @@ impl ActionType {
     }
 }
 
-impl fmt::Display for ActionType {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.numeral())
-    }
-}
+spelled!(
+    ActionType,
+    "action type",
+    [
+        ActionType::I,
+        ActionType::II,
+        ActionType::III,
+        ActionType::IV,
+        ActionType::V,
+        ActionType::VI,
+        ActionType::VII,
+    ]
+);
 
 /// An action's type with the space each of its constraints is placed in
 /// (Ow-only constraints placed as the module documents).
@@ -120,7 +134,7 @@ impl fmt::Display for Classification {
         if self.path_in_goal_space() {
             write!(f, "type II: one goal, with a path in the goal's space (no conflict: rest held)")
         } else {
-            write!(f, "type {}: {}", self.action_type, self.action_type.description())
+            write!(f, "type {}: {}", self.action_type.numeral(), self.action_type.description())
         }
     }
 }
@@ -313,7 +327,8 @@ fn check_sizes(action: &Action, path: &PathConstraint) -> Result<(), DecomposeEr
 
 /// A segment's pattern (paper §5.3): path and hold primitives only,
 /// goal primitives only, or both.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum SegmentPattern {
     /// 1: `MP^p +Pa MP^-p`, every primitive a path (hold is a path, P = void).
     Path = 1,
@@ -322,6 +337,12 @@ pub enum SegmentPattern {
     /// 3: `MP^p +Pa MP^-g`, paths and goals.
     Mixed = 3,
 }
+
+spelled!(
+    SegmentPattern,
+    "segment pattern",
+    [SegmentPattern::Path, SegmentPattern::Goal, SegmentPattern::Mixed]
+);
 
 impl SegmentPattern {
     /// 1, 2 or 3.

@@ -9,7 +9,7 @@ use crate::math::Real;
 ///
 /// Spans take no part in equality, so that two parses of differently
 /// formatted text compare equal when they say the same thing.
-#[derive(Debug, Clone, Copy, Default, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, Default, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Span {
     /// First byte.
     pub start: usize,

@@ -6,9 +6,33 @@ use std::path::PathBuf;
 use super::ast::Span;
 use crate::math::{JointVector, Real, Rotation3, Vector3};
 use crate::robot::{Robot, RobotError, RobotOptions};
+use crate::spelling::spelled;
+
+spelled!(Space, "space", [Space::Cpsa, Space::Hat]);
+spelled!(
+    Variable,
+    "variable",
+    [Variable::Pw, Variable::Ow, Variable::Swivel, Variable::Os, Variable::Elbow]
+);
+spelled!(
+    SolverChoice,
+    "solver",
+    [
+        SolverChoice::Auto,
+        SolverChoice::Qp,
+        SolverChoice::Rrt,
+        SolverChoice::Map,
+        SolverChoice::Gpm,
+        SolverChoice::Clik,
+        SolverChoice::Pmp,
+        SolverChoice::Hamp,
+    ]
+);
+spelled!(PositionFrame, "frame", [PositionFrame::Base, PositionFrame::Root]);
 
 /// The two representation spaces (docs/design.md §3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Space {
     /// (Pw, Ow, θsw).
     Cpsa,
@@ -25,7 +49,8 @@ impl Space {
         }
     }
 
-    /// "CPSA" or "HAT".
+    /// "CPSA" or "HAT", the paper's names, for prose (diagnostics, explanations); values
+    /// are spelled [`Self::as_str`].
     pub fn name(self) -> &'static str {
         match self {
             Space::Cpsa => "CPSA",
@@ -35,7 +60,10 @@ impl Space {
 }
 
 /// The five state variables.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
 pub enum Variable {
     /// Wrist position Pw.
     Pw,
@@ -43,7 +71,9 @@ pub enum Variable {
     Ow,
     /// Swivel angle θsw.
     Swivel,
-    /// Shoulder frame Os.
+    /// Shoulder frame Os, spelled `shoulder_frame` as the paper's name for it (`os` reads as
+    /// nothing).
+    #[serde(rename = "shoulder_frame")]
     Os,
     /// Elbow angle θe.
     Elbow,
@@ -99,7 +129,8 @@ impl Variable {
 }
 
 /// What kind of value a variable takes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum ValueKind {
     /// A point in {b} (m).
     Position,
@@ -110,7 +141,8 @@ pub enum ValueKind {
 }
 
 /// A goal value of one variable, in SI units and {b}.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Target {
     /// Pw (m).
     Position(Vector3),
@@ -121,7 +153,7 @@ pub enum Target {
 }
 
 /// Goals for variables of one space: `Pw Ow = (..)`.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Goal {
     /// Each variable with its target.
     pub targets: Vec<(Variable, Target)>,
@@ -132,7 +164,7 @@ pub struct Goal {
 }
 
 /// An action's goal constraint GC: `G` or `G1 ≻ G2`.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GoalConstraint {
     /// G, or the higher-priority G1.
     pub primary: Goal,
@@ -141,7 +173,8 @@ pub struct GoalConstraint {
 }
 
 /// An axis of a path feature.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Axis {
     /// A fixed unit direction of {b} (x, y, z and their negations).
     Base(Vector3),
@@ -150,7 +183,8 @@ pub enum Axis {
 }
 
 /// Body axes: upper arm r, arm-plane normal l, finger f, palm normal p.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum BodyAxis {
     /// Upper-arm direction r.
     R,
@@ -163,7 +197,8 @@ pub enum BodyAxis {
 }
 
 /// A path feature P with its size S (SI).
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum PathFeature {
     /// Pw along a straight line; the length may be left to Opt2.
     Line {
@@ -189,7 +224,7 @@ pub enum PathFeature {
 }
 
 /// One item of a path constraint.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PathItem {
     /// Variables that keep the feature.
     pub variables: Vec<Variable>,
@@ -198,7 +233,7 @@ pub struct PathItem {
 }
 
 /// An action's path constraint PC.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PathConstraint {
     /// Items, all of one space.
     pub items: Vec<PathItem>,
@@ -211,7 +246,7 @@ pub struct PathConstraint {
 }
 
 /// A primitive of an explicit segment.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Primitive {
     /// Variables it drives.
     pub variables: Vec<Variable>,
@@ -220,7 +255,8 @@ pub struct Primitive {
 }
 
 /// The constraint of a primitive.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum PrimitiveConstraint {
     /// Reach these targets (one per variable).
     Goal(Vec<Target>),
@@ -231,7 +267,7 @@ pub enum PrimitiveConstraint {
 }
 
 /// An explicit movement segment: primitives covering one space exactly.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Segment {
     /// Its space.
     pub space: Space,
@@ -242,7 +278,8 @@ pub struct Segment {
 }
 
 /// The body of an action.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum ActionBody {
     /// Constraints to decompose.
     Constraints {
@@ -258,7 +295,7 @@ pub enum ActionBody {
 }
 
 /// Which solver to use.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SolverChoice {
     /// docs/design.md §5 policy.
@@ -292,14 +329,14 @@ impl SolverChoice {
         ("hamp", SolverChoice::Hamp),
     ];
 
-    /// The name used in task files.
+    /// The name used in task files: its one spelling.
     pub fn name(self) -> &'static str {
-        Self::NAMES.iter().find(|(_, s)| *s == self).map_or("auto", |(n, _)| n)
+        self.as_str()
     }
 }
 
 /// A solver chosen for one segment of an action: `solver MS2 rrt`.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SegmentSolver {
     /// The segment's index in its action, from 0 (`MS1` is 0).
     pub segment: usize,
@@ -319,7 +356,7 @@ impl Action {
 }
 
 /// One action of a task.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Action {
     /// Name.
     pub name: String,
@@ -347,7 +384,8 @@ pub struct Action {
 }
 
 /// The start of the motion.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Start {
     /// Joint angles (rad).
     Joints(JointVector),
@@ -356,7 +394,8 @@ pub enum Start {
 }
 
 /// An obstacle's shape, in {b} (or the root frame, per settings), SI.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Shape {
     /// Box: centre, full edge lengths along its own axes, and its rotation.
     Box {
@@ -398,7 +437,7 @@ pub enum Shape {
 }
 
 /// A named obstacle.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Obstacle {
     /// Unique name.
     pub name: String,
@@ -407,7 +446,7 @@ pub struct Obstacle {
 }
 
 /// The frame positions are given in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PositionFrame {
     /// {b}: origin at the shoulder centre (default).
@@ -417,7 +456,7 @@ pub enum PositionFrame {
 }
 
 /// Task settings with their defaults.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Settings {
     /// Output rate (Hz), default 100.
     pub rate: Real,
@@ -447,7 +486,7 @@ impl Default for Settings {
 }
 
 /// A validated A2ML task.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Task {
     /// The task's name.
     pub name: String,

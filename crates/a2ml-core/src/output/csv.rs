@@ -37,7 +37,8 @@ pub(super) fn header(joint_names: &[&str]) -> String {
 }
 
 /// The reference columns, after the joints': the running segment's index, then Pw (m), Ow
-/// (quaternion x y z w), θsw (rad), Os (quaternion), θe (rad).
+/// (quaternion x y z w), θsw (rad), Os (quaternion), θe (rad); each named by its variable's
+/// spelling ([`crate::language::Variable::as_str`]).
 pub(super) const REFERENCE_COLUMNS: [&str; 14] = [
     "ref_segment",
     "ref_pw_x",
@@ -48,10 +49,10 @@ pub(super) const REFERENCE_COLUMNS: [&str; 14] = [
     "ref_ow_z",
     "ref_ow_w",
     "ref_swivel",
-    "ref_os_x",
-    "ref_os_y",
-    "ref_os_z",
-    "ref_os_w",
+    "ref_shoulder_frame_x",
+    "ref_shoulder_frame_y",
+    "ref_shoulder_frame_z",
+    "ref_shoulder_frame_w",
     "ref_elbow",
 ];
 

@@ -144,7 +144,8 @@ fn metadata(robot: &Robot, task: &Task, plan: &Plan) -> Metadata {
         ("safety_distance_m".to_owned(), plan.safety_distance.to_string()),
     ]);
     if !plan.warnings.is_empty() {
-        entries.insert("warnings".to_owned(), plan.warnings.join("\n"));
+        let lines: Vec<String> = plan.warnings.iter().map(ToString::to_string).collect();
+        entries.insert("warnings".to_owned(), lines.join("\n"));
     }
     Metadata { name: "a2ml".to_owned(), metadata: entries }
 }

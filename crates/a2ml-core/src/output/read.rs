@@ -320,8 +320,9 @@ pub fn read_mcap_bytes(bytes: &[u8], path: &str) -> Result<RecordedPlan, ReadErr
 
 /// The value among `candidates` that serialises as `value` (so that the spellings are the
 /// writer's, whatever they are).
-fn spelled<T: serde::Serialize + Copy>(value: &Value, candidates: &[T]) -> Option<T> {
-    candidates.iter().copied().find(|c| serde_json::to_value(c).is_ok_and(|v| v == *value))
+/// The enum value a JSON string spells ([`crate::spelling`]).
+fn spelled<T: crate::spelling::Spelled>(value: &Value) -> Option<T> {
+    value.as_str().and_then(|text| crate::spelling::parse(text).ok())
 }
 
 fn field<'v>(value: &'v Value, name: &str) -> Result<&'v Value, String> {
@@ -372,15 +373,14 @@ fn segment_record(value: &Value) -> Result<RecordedSegment, String> {
         .as_array()
         .ok_or("`focus` is not a list")?
         .iter()
-        .map(|v| spelled(v, &Variable::ALL).ok_or_else(|| format!("unknown variable {v}")))
+        .map(|v| spelled::<Variable>(v).ok_or_else(|| format!("unknown variable {v}")))
         .collect::<Result<_, _>>()?;
-    let solvers = SolverChoice::NAMES.map(|(_, s)| s);
     Ok(RecordedSegment {
         action: text(value, "action")?,
         action_index: index(value, "action_index")?,
         segment: index(value, "segment")?,
-        action_type: value.get("action_type").and_then(|t| spelled(t, &ActionType::ALL)),
-        solver: spelled(field(value, "solver")?, &solvers),
+        action_type: value.get("action_type").and_then(spelled::<ActionType>),
+        solver: spelled::<SolverChoice>(field(value, "solver")?),
         focus,
         start: number(value, "start")?,
         end: number(value, "end")?,

@@ -159,7 +159,7 @@ pub fn status(s: &SegmentReport) -> String {
     } else {
         "missed"
     };
-    s.fallback.map_or_else(|| outcome.to_owned(), |why| format!("{outcome} ({})", why.name()))
+    s.fallback.map_or_else(|| outcome.to_owned(), |why| format!("{outcome} ({why})"))
 }
 
 /// The plan's outcome in a sentence and its warnings.
@@ -185,7 +185,7 @@ fn summary(out: &mut String, input: &ReportInput) {
     } else {
         out.push_str("<h3>Warnings</h3>\n<ul class=\"warnings\">\n");
         for w in &plan.warnings {
-            let _ = writeln!(out, "<li>{}</li>", escape(w));
+            let _ = writeln!(out, "<li>{}</li>", escape(&w.to_string()));
         }
         out.push_str("</ul>\n");
     }
@@ -207,12 +207,12 @@ fn number_cell(value: Real, decimals: usize) -> String {
     format!("<td class=\"n\" data-value=\"{value:?}\">{}</td>", fixed(value, decimals))
 }
 
-/// One error as `Pw 0.42 mm` or `θsw 0.31°`.
+/// One error as `pw 0.42 mm` or `swivel 0.31°`.
 fn error_text(variable: Variable, error: Real) -> String {
     if variable == Variable::Pw {
-        format!("Pw {} mm", fixed(error * 1e3, 2))
+        format!("{variable} {} mm", fixed(error * 1e3, 2))
     } else {
-        format!("{} {}°", variable.symbol(), fixed(error.to_degrees(), 2))
+        format!("{variable} {}°", fixed(error.to_degrees(), 2))
     }
 }
 
@@ -236,14 +236,14 @@ pub fn segments_table(out: &mut String, segments: &[SegmentReport]) {
         let class = if status.starts_with("ok") { "ok" } else { "bad" };
         let _ = writeln!(
             out,
-            "<tr><td>{}</td><td class=\"n\">{}</td><td>{}</td><td class=\"n\">{}</td><td>{}</td>\
+            "<tr><td>{}</td><td class=\"n\">{}</td><td>{}</td><td>{}</td><td>{}</td>\
              <td>{}</td>{}{}<td>{}</td>{clearance}{}<td class=\"{class}\">{}</td></tr>",
             escape(&s.action),
             s.segment + 1,
-            s.action_type.map_or("-", |t| t.numeral()),
-            s.pattern.number(),
-            s.space.name(),
-            s.solver.name(),
+            s.action_type.map_or("-", |t| t.as_str()),
+            s.pattern,
+            s.space,
+            s.solver,
             number_cell(s.start, 3),
             number_cell(s.end, 3),
             escape(&errors.join(", ")),

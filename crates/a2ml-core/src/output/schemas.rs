@@ -12,6 +12,10 @@
 use serde_json::{Value, json};
 
 use super::messages::SEGMENT_OPTIONAL;
+use crate::decompose::{ActionType, SegmentPattern};
+use crate::language::{SolverChoice, Space, Variable};
+use crate::solve::Fallback;
+use crate::spelling::{Spelled, spellings};
 
 /// Schema name and body of a channel.
 pub(super) struct Schema {
@@ -35,6 +39,11 @@ fn typed(kind: &str) -> Value {
 
 fn described(kind: &str, description: &str) -> Value {
     json!({ "type": kind, "description": description })
+}
+
+/// A string field taking the spellings of `T` only.
+fn enumerated<T: Spelled>(description: &str) -> Value {
+    json!({ "type": "string", "enum": spellings::<T>(), "description": description })
 }
 
 fn array(items: Value) -> Value {
@@ -400,7 +409,11 @@ pub(super) fn segment() -> Schema {
     let (n, s, b, i) = (typed("number"), typed("string"), typed("boolean"), typed("integer"));
     let error = object(
         None,
-        json!({ "variable": s, "error": described("number", "m or rad"), "within": b }),
+        json!({
+            "variable": enumerated::<Variable>("the state variable"),
+            "error": described("number", "m or rad"),
+            "within": b
+        }),
         &["variable", "error", "within"],
     );
     let mut clearance = object(
@@ -409,7 +422,11 @@ pub(super) fn segment() -> Schema {
         &["distance", "time", "link", "obstacle"],
     );
     clearance["description"] = json!("smallest clearance (m) and where; absent without obstacles");
-    let qp = object(None, json!({ "steps": i, "clarabel_steps": i }), &["steps", "clarabel_steps"]);
+    let qp = object(
+        None,
+        json!({ "steps": i, "clarabel_steps": i, "clarabel_almost_solved": i }),
+        &["steps", "clarabel_steps", "clarabel_almost_solved"],
+    );
     let mut rrt = object(
         None,
         json!({ "samples": i, "nodes": i, "collision_checks": i }),
@@ -421,11 +438,15 @@ pub(super) fn segment() -> Schema {
         "action": s,
         "action_index": i,
         "segment": i,
-        "action_type": described("string", "I to VII; absent for explicit segments"),
-        "space": described("string", "Cpsa or Hat"),
-        "pattern": described("string", "Path (1), Goal (2) or Mixed (3)"),
-        "solver": s,
-        "focus": array(s.clone()),
+        "action_type": enumerated::<ActionType>(
+            "the paper's type I to VII, in lower case; absent for explicit segments"
+        ),
+        "space": enumerated::<Space>("the representation space"),
+        "pattern": enumerated::<SegmentPattern>(
+            "the paper's pattern: path (1), goal (2) or mixed (3)"
+        ),
+        "solver": enumerated::<SolverChoice>("the solver that produced the motion"),
+        "focus": array(enumerated::<Variable>("a variable of the featured primitive")),
         "start": described("number", "s"),
         "end": described("number", "s"),
         "duration": described("number", "s"),
@@ -440,10 +461,8 @@ pub(super) fn segment() -> Schema {
         "reached": b,
         "qp": qp,
         "rrt": rrt,
-        "fallback": described(
-            "string",
-            "qp_stalled, qp_missed_goal or qp_left_path: why auto went on from the QP to the \
-             solver named; absent if it did not"
+        "fallback": enumerated::<Fallback>(
+            "why auto went on from the QP to the solver named; absent if it did not"
         ),
         "peak_velocity_ratio": described("number", "largest |q'|/limit over the segment"),
         "peak_acceleration_ratio": described("number", "largest |q''|/limit over the segment"),

@@ -11,7 +11,7 @@ use crate::language::{Limits, Task, samples};
 use crate::math::Real;
 use crate::robot::Robot;
 
-use super::report::SegmentReport;
+use super::report::{SegmentReport, Warning, WarningKind};
 
 /// Why a decomposed task is not planned.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -95,7 +95,7 @@ pub fn before_solving(
     safety: Real,
     limits: &Limits,
     allow_close_start: bool,
-) -> Result<Vec<String>, CheckError> {
+) -> Result<Vec<Warning>, CheckError> {
     let segments: usize = decomposition.actions.iter().map(|a| a.segments.len()).sum();
     if segments > limits.max_segments {
         return Err(CheckError::TooManySegments { segments, limit: limits.max_segments });
@@ -137,16 +137,17 @@ pub fn before_solving(
             if !allow_close_start {
                 return Err(error);
             }
-            warnings.push(error.to_string());
+            let message = error.to_string();
+            warnings.push(Warning::on_segment(WarningKind::CloseStart, &action.name, 0, message));
         }
     }
     Ok(warnings)
 }
 
 /// The warning for a segment that came closer than the safety distance, if it did.
-pub fn too_close(s: &SegmentReport, safety: Real) -> Option<String> {
+pub fn too_close(s: &SegmentReport, safety: Real) -> Option<Warning> {
     let c = s.clearance.as_ref().filter(|c| c.distance < safety)?;
-    Some(format!(
+    let message = format!(
         "action `{}`, segment {}: `{}` and `{}` come {:.1} mm apart at t = {:.3} s, closer \
          than the safety distance of {:.1} mm",
         s.action,
@@ -156,5 +157,6 @@ pub fn too_close(s: &SegmentReport, safety: Real) -> Option<String> {
         c.distance * 1e3,
         c.time,
         safety * 1e3
-    ))
+    );
+    Some(Warning::on_segment(WarningKind::TooClose, &s.action, s.segment, message))
 }

@@ -53,14 +53,15 @@ pub struct ComparisonRecord {
     pub action: Option<String>,
     /// The segment's index in its action (0-based).
     pub segment: Option<usize>,
-    /// Final error of each variable of the segment's space, by ASCII name (m or rad).
+    /// Final error of each variable of the segment's space, keyed by its spelling
+    /// ([`crate::language::Variable::as_str`]) (m or rad).
     pub errors: BTreeMap<String, Real>,
     /// Every goal within tolerance at the end.
     pub reached: Option<bool>,
     /// The hard path kept (always true for a soft one).
     pub path_kept: Option<bool>,
     /// Largest distance from the path of any path variable (m for Pw, rad otherwise), by
-    /// ASCII name.
+    /// its spelling.
     pub path_errors: BTreeMap<String, Real>,
     /// Smallest distance of any joint to its position limits (rad; negative = outside).
     pub limit_margin: Option<Real>,
@@ -113,7 +114,7 @@ fn segment_record(
     empty: &ComparisonRecord,
 ) -> ComparisonRecord {
     let by_name = |errors: &[super::VariableError]| {
-        errors.iter().map(|e| (e.variable.ascii().to_owned(), e.error)).collect()
+        errors.iter().map(|e| (e.variable.as_str().to_owned(), e.error)).collect()
     };
     let (lower, upper, speed) = (robot.lower(), robot.upper(), robot.velocity_limits());
     let t = &plan.trajectory;

@@ -37,5 +37,5 @@ pub use monitor::Monitor;
 pub use plan::{PlanOptions, Progress, SolveError, plan, plan_with_progress};
 pub use report::{
     Fallback, Plan, QpStats, ReferenceSample, ReferenceState, SegmentReport, Tolerance,
-    VariableError,
+    VariableError, Warning, WarningKind,
 };

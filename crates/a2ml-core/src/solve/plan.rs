@@ -22,7 +22,9 @@ use super::monitor::{Monitor, deadline_after};
 use super::problem::{Component, SegmentProblem};
 use super::qp::{self, QpError, QpOptions};
 use super::references::{Placed, reference_ends, reference_samples};
-use super::report::{Fallback, Plan, QpStats, SegmentReport, Tolerance, VariableError};
+use super::report::{
+    Fallback, Plan, QpStats, SegmentReport, Tolerance, VariableError, Warning, WarningKind,
+};
 use super::rrt::{RrtError, RrtOptions, RrtStats, rrt_connect_monitored};
 use super::timing::{TimedPath, time_constrained, time_parameterise};
 use super::{clik, gpm, pmp};
@@ -318,7 +320,9 @@ pub fn plan_with_progress(
     warnings.extend(state.notes);
     warnings.append(&mut notes);
     if !task.scene.is_empty() {
-        warnings.extend(robot.geometry_warnings.iter().map(|w| format!("collision geometry: {w}")));
+        warnings.extend(robot.geometry_warnings.iter().map(|w| {
+            Warning::on_task(WarningKind::CollisionGeometry, format!("collision geometry: {w}"))
+        }));
     }
     let placed: Vec<Placed> = state
         .pieces
@@ -407,7 +411,7 @@ struct Solver<'a> {
     q: JointVector,
     pieces: Vec<Piece>,
     /// Warnings other than missed goals: fallbacks and stretched durations.
-    notes: Vec<String>,
+    notes: Vec<Warning>,
 }
 
 /// One segment to solve, with what every solver and the report need.
@@ -428,6 +432,11 @@ impl Job<'_> {
     /// The warning prefix naming the action and segment.
     fn name(&self) -> String {
         format!("action `{}`, segment {}", self.action.name, self.k + 1)
+    }
+
+    /// A warning of `kind` naming the job's action and segment.
+    fn warning(&self, kind: WarningKind, message: String) -> Warning {
+        Warning::on_segment(kind, &self.action.name, self.k, message)
     }
 
     fn rrt_failed(&self, source: RrtError) -> SolveError {
@@ -509,7 +518,7 @@ impl Solver<'_> {
     /// it does, and the output checked again at every instant until it holds the limits (or
     /// the rounds run out). Completes the reports with the measures of the output. Returns
     /// the output and the notes on what was repaired.
-    fn finish(&mut self) -> Result<(Trajectory, Vec<String>), SolveError> {
+    fn finish(&mut self) -> Result<(Trajectory, Vec<Warning>), SolveError> {
         for piece in &mut self.pieces {
             let t = &piece.trajectory;
             let stretch = peaks(t, t.start(), t.end()).stretch(&self.limits);
@@ -542,7 +551,7 @@ impl Solver<'_> {
             if piece.stretch > 1.0 {
                 let r = &piece.report;
                 let solved = piece.trajectory.duration();
-                notes.push(format!(
+                let message = format!(
                     "action `{}`, segment {}: slowed down {:.3} times ({:.2} s instead of {:.2} s) \
                      to keep every joint within its velocity and acceleration limits",
                     r.action,
@@ -550,6 +559,12 @@ impl Solver<'_> {
                     piece.stretch,
                     solved * piece.stretch,
                     solved
+                );
+                notes.push(Warning::on_segment(
+                    WarningKind::SlowedDown,
+                    &r.action,
+                    r.segment,
+                    message,
                 ));
             }
             complete(piece, &output, self.robot, &self.limits);
@@ -560,7 +575,7 @@ impl Solver<'_> {
     /// Every segment joined at its current stretch: +Tr within an action (each blend
     /// shortened where it would exceed a limit), +Se between actions. Sets each piece's start;
     /// returns the trajectory and a note per shortened blend.
-    fn join_all(&mut self) -> Result<(Trajectory, Vec<String>), SolveError> {
+    fn join_all(&mut self) -> Result<(Trajectory, Vec<Warning>), SolveError> {
         let mut notes = Vec::new();
         // Each join only changes the samples from its seam on, so only the tail is rebuilt:
         // joining stays linear in the number of segments.
@@ -584,13 +599,19 @@ impl Solver<'_> {
                             .unwrap_or(0.0);
                         if used < overlap {
                             let r = &self.pieces[i].report;
-                            notes.push(format!(
+                            let message = format!(
                                 "action `{}`, segment {}: the +Tr blend into it overlaps {:.3} s \
                                  instead of {:.3} s to keep the joint limits",
                                 r.action,
                                 r.segment + 1,
                                 used,
                                 overlap
+                            );
+                            notes.push(Warning::on_segment(
+                                WarningKind::BlendShortened,
+                                &r.action,
+                                r.segment,
+                                message,
                             ));
                         }
                         prev_start + prev_duration - used
@@ -648,7 +669,8 @@ impl Solver<'_> {
         let pattern = job.segment.pattern;
         let kept = |this: &mut Self, source: RrtError, why: &str| {
             let name = job.name();
-            this.notes.push(format!("{name}: {why}; rrt: {source}; the QP's result is kept"));
+            let message = format!("{name}: {why}; rrt: {source}; the QP's result is kept");
+            this.notes.push(job.warning(WarningKind::RrtFailed, message));
         };
         match self.options.solver.unwrap_or(job.segment.solver) {
             SolverChoice::Qp => self.qp(job, monitor),
@@ -684,11 +706,12 @@ impl Solver<'_> {
                         Ok(Solved { fallback: Some(why), ..rrt })
                     }
                     Ok(_) => {
-                        self.notes.push(format!(
+                        let message = format!(
                             "{}: {}; rrt did not do better; the QP's result is kept",
                             job.name(),
                             why.describe()
-                        ));
+                        );
+                        self.notes.push(job.warning(WarningKind::RrtNoBetter, message));
                         Ok(qp)
                     }
                     Err(SolveError::Rrt { source, .. }) => {
@@ -847,7 +870,8 @@ impl Solver<'_> {
         let planned =
             plan_handover(self.robot, &self.q, &target, job.scene, &options).map_err(failed)?;
         if !planned.limit_violations.is_empty() {
-            self.notes.push(format!("{}: the hamp motion exceeds a joint speed limit", job.name()));
+            let message = format!("{}: the hamp motion exceeds a joint speed limit", job.name());
+            self.notes.push(job.warning(WarningKind::HampOverSpeed, message));
         }
         Ok(self.judged(job, SolverChoice::Hamp, planned.trajectory, 0.0, false, None))
     }
@@ -863,13 +887,14 @@ impl Solver<'_> {
     /// An RRT path as solved: the stretch noted, the end's errors.
     fn timed(&mut self, job: &Job, timed: TimedPath, stats: RrtStats) -> Solved {
         if timed.stretched {
-            self.notes.push(format!(
+            let message = format!(
                 "{}: the rrt path takes {:.2} s instead of {:.2} s to keep every joint within \
                  its velocity and acceleration limits",
                 job.name(),
                 timed.duration,
                 job.segment.duration
-            ));
+            );
+            self.notes.push(job.warning(WarningKind::RrtSlowed, message));
         }
         self.judged(job, SolverChoice::Rrt, timed.trajectory, 0.0, false, Some(stats))
     }
@@ -1151,14 +1176,15 @@ fn limit_margin(robot: &Robot, trajectory: &Trajectory) -> Real {
 }
 
 /// The warning for a segment that left its hard path.
-fn left_path(s: &SegmentReport) -> String {
+fn left_path(s: &SegmentReport) -> Warning {
     let what: Vec<String> = s.path_errors.iter().filter(|e| !e.within).map(describe).collect();
-    format!(
+    let message = format!(
         "action `{}`, segment {}: left its hard path: {}",
         s.action,
         s.segment + 1,
         what.join(", ")
-    )
+    );
+    Warning::on_segment(WarningKind::LeftPath, &s.action, s.segment, message)
 }
 
 /// "Pw by 3.1 mm", "θsw by 2.00°".
@@ -1170,20 +1196,27 @@ fn describe(e: &VariableError) -> String {
 }
 
 /// The warning for a segment whose output exceeds a joint limit.
-fn over_limits(s: &SegmentReport) -> String {
-    format!(
+fn over_limits(s: &SegmentReport) -> Warning {
+    let message = format!(
         "action `{}`, segment {}: exceeds the joint limits (peak |q'|/limit {:.3}, |q''|/limit \
          {:.3}, or a position limit)",
         s.action,
         s.segment + 1,
         s.peak_velocity_ratio,
         s.peak_acceleration_ratio
-    )
+    );
+    Warning::on_segment(WarningKind::OverLimits, &s.action, s.segment, message)
 }
 
 /// The warning for a segment that missed its goal.
-fn missed(s: &SegmentReport) -> String {
+fn missed(s: &SegmentReport) -> Warning {
     let what: Vec<String> = s.errors.iter().filter(|e| !e.within).map(describe).collect();
     let why = if s.stalled { ", stalled" } else { "" };
-    format!("action `{}`, segment {}: missed {}{why}", s.action, s.segment + 1, what.join(", "))
+    let message = format!(
+        "action `{}`, segment {}: missed {}{why}",
+        s.action,
+        s.segment + 1,
+        what.join(", ")
+    );
+    Warning::on_segment(WarningKind::MissedGoal, &s.action, s.segment, message)
 }

@@ -41,6 +41,7 @@ use crate::language::{Space, Target, Variable};
 use crate::math::{DOF, JointVector, Matrix7, Real, Vector7, rotation_log, wrap_angle};
 use crate::profile::{Reference, Role, Sample, WeightOptions, WeightSchedule};
 use crate::robot::Robot;
+use crate::spelling::spelled;
 use crate::trajectory::{Trajectory, TrajectoryError};
 
 /// Settings of the velocity QP.
@@ -141,7 +142,22 @@ pub enum QpError {
         /// Segment time (s).
         time: Real,
         /// Clarabel's status.
-        status: String,
+        status: ClarabelStatus,
+    },
+    /// Clarabel refused the step's problem or its update (a shape or value it cannot take).
+    #[error("at t = {time:.3} s Clarabel refused the QP: {reason}")]
+    Refused {
+        /// Segment time (s).
+        time: Real,
+        /// Clarabel's message.
+        reason: String,
+    },
+    /// Clarabel refused the settings this solver gives it, which are fixed: a bug in a2ml or
+    /// a Clarabel that validates them differently.
+    #[error("Clarabel refused the QP's settings: {reason}")]
+    Settings {
+        /// Clarabel's message.
+        reason: String,
     },
     /// The state where the arm stopped cannot be held.
     #[error("the state where the arm stopped cannot be held: {reason}")]
@@ -587,7 +603,6 @@ impl<'a> Controller<'a> {
         rows: &[(Vector7, Real)],
         t: Real,
     ) -> Result<Vector7, QpError> {
-        let unsolved = |status| QpError::Unsolved { time: t, status };
         // Room for the rows present now, grown by doubling: far fewer rows than pairs are
         // ever near at once, and the interior-point cost grows with the rows.
         let mut solver = match self.clarabel.take() {
@@ -598,12 +613,20 @@ impl<'a> Controller<'a> {
                 while capacity < rows.len() {
                     capacity *= 2;
                 }
-                Clarabel::new(capacity).map_err(unsolved)?
+                Clarabel::new(capacity).map_err(|e| e.at(t))?
             }
         };
-        let x = solver.solve(p, c, lower, upper, rows).map_err(unsolved);
+        let solved = solver.solve(p, c, lower, upper, rows);
         self.clarabel = Some(solver);
-        x
+        match solved {
+            Ok((x, status)) => {
+                if status == ClarabelStatus::AlmostSolved {
+                    self.timing.almost_solved += 1;
+                }
+                Ok(x)
+            }
+            Err(e) => Err(e.at(t)),
+        }
     }
 
     /// A problem holding every variable at its value at `pose` for `duration`.
@@ -823,8 +846,95 @@ struct Clarabel {
     b_values: Vec<Real>,
 }
 
+/// Why Clarabel gave no answer to a step, before the step's time is known.
+#[derive(Debug)]
+enum ClarabelFailure {
+    Status(ClarabelStatus),
+    Refused(String),
+    Settings(String),
+}
+
+impl ClarabelFailure {
+    fn at(self, time: Real) -> QpError {
+        match self {
+            Self::Status(status) => QpError::Unsolved { time, status },
+            Self::Refused(reason) => QpError::Refused { time, reason },
+            Self::Settings(reason) => QpError::Settings { reason },
+        }
+    }
+}
+
+/// Clarabel's status at the end of a solve, in a2ml's spelling (Clarabel enters a2ml here
+/// only, so its type does not leave this module).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ClarabelStatus {
+    /// The solver has not run.
+    Unsolved,
+    /// Solved to the tolerances.
+    Solved,
+    /// Primal infeasible: the bounds and damper rows cannot all hold.
+    PrimalInfeasible,
+    /// Dual infeasible (unbounded): cannot happen with a positive definite P.
+    DualInfeasible,
+    /// Solved to reduced accuracy.
+    AlmostSolved,
+    /// Primal infeasible, to reduced accuracy.
+    AlmostPrimalInfeasible,
+    /// Dual infeasible, to reduced accuracy.
+    AlmostDualInfeasible,
+    /// The iteration limit passed.
+    MaxIterations,
+    /// Clarabel's own time limit passed (none is set).
+    MaxTime,
+    /// A numerical error.
+    NumericalError,
+    /// No progress.
+    InsufficientProgress,
+    /// Stopped by a callback (none is set).
+    CallbackTerminated,
+}
+
+spelled!(
+    ClarabelStatus,
+    "clarabel status",
+    [
+        ClarabelStatus::Unsolved,
+        ClarabelStatus::Solved,
+        ClarabelStatus::PrimalInfeasible,
+        ClarabelStatus::DualInfeasible,
+        ClarabelStatus::AlmostSolved,
+        ClarabelStatus::AlmostPrimalInfeasible,
+        ClarabelStatus::AlmostDualInfeasible,
+        ClarabelStatus::MaxIterations,
+        ClarabelStatus::MaxTime,
+        ClarabelStatus::NumericalError,
+        ClarabelStatus::InsufficientProgress,
+        ClarabelStatus::CallbackTerminated,
+    ]
+);
+
+impl From<SolverStatus> for ClarabelStatus {
+    fn from(status: SolverStatus) -> Self {
+        match status {
+            SolverStatus::Unsolved => Self::Unsolved,
+            SolverStatus::Solved => Self::Solved,
+            SolverStatus::PrimalInfeasible => Self::PrimalInfeasible,
+            SolverStatus::DualInfeasible => Self::DualInfeasible,
+            SolverStatus::AlmostSolved => Self::AlmostSolved,
+            SolverStatus::AlmostPrimalInfeasible => Self::AlmostPrimalInfeasible,
+            SolverStatus::AlmostDualInfeasible => Self::AlmostDualInfeasible,
+            SolverStatus::MaxIterations => Self::MaxIterations,
+            SolverStatus::MaxTime => Self::MaxTime,
+            SolverStatus::NumericalError => Self::NumericalError,
+            SolverStatus::InsufficientProgress => Self::InsufficientProgress,
+            SolverStatus::CallbackTerminated => Self::CallbackTerminated,
+        }
+    }
+}
+
 impl Clarabel {
-    fn new(pair_rows: usize) -> Result<Self, String> {
+    fn new(pair_rows: usize) -> Result<Self, ClarabelFailure> {
         let m = 2 * DOF + pair_rows;
         // P: the upper triangle of a dense 7x7, column by column.
         let p_colptr: Vec<usize> = (0..=DOF).map(|j| j * (j + 1) / 2).collect();
@@ -843,8 +953,8 @@ impl Clarabel {
         let b_values = vec![1.0; m];
         let q_values = vec![0.0; DOF];
         let cones = [SupportedConeT::NonnegativeConeT(m)];
-        let solver = DefaultSolver::new(&p, &q_values, &a, &b_values, &cones, settings())
-            .map_err(|e| e.to_string())?;
+        let solver = DefaultSolver::new(&p, &q_values, &a, &b_values, &cones, settings()?)
+            .map_err(|e| ClarabelFailure::Refused(e.to_string()))?;
         Ok(Self { solver, pair_rows, p_values, q_values, a_values, b_values })
     }
 
@@ -855,7 +965,7 @@ impl Clarabel {
         lower: &Vector7,
         upper: &Vector7,
         rows: &[(Vector7, Real)],
-    ) -> Result<Vector7, String> {
+    ) -> Result<(Vector7, ClarabelStatus), ClarabelFailure> {
         let mut k = 0;
         for j in 0..DOF {
             for i in 0..=j {
@@ -881,14 +991,20 @@ impl Clarabel {
             s.update_A(&self.a_values).map_err(|e| e.to_string())?;
             s.update_b(&self.b_values).map_err(|e| e.to_string())
         };
-        update(&mut self.solver)?;
+        update(&mut self.solver).map_err(ClarabelFailure::Refused)?;
         self.solver.solve();
         let solution = &self.solver.solution;
-        match solution.status {
-            SolverStatus::Solved | SolverStatus::AlmostSolved => {
-                Ok(Vector7::from_column_slice(&solution.x))
+        // The one place Clarabel's outcome is decided. `almost_solved` is accepted: it means
+        // the tolerances of 1e-7 were met only to Clarabel's reduced ones (5e-5 to 1e-4 by
+        // default), which on a 7-variable velocity step is far below what the control loop
+        // corrects at the next 2 ms step; the joint bounds and damper rows are re-checked on
+        // the output by the plan, and refusing it would stop a segment over a rounding. The
+        // count is kept in [`QpStats::clarabel_almost_solved`].
+        match ClarabelStatus::from(solution.status) {
+            status @ (ClarabelStatus::Solved | ClarabelStatus::AlmostSolved) => {
+                Ok((Vector7::from_column_slice(&solution.x), status))
             }
-            status => Err(format!("{status:?}")),
+            status => Err(ClarabelFailure::Status(status)),
         }
     }
 }
@@ -896,7 +1012,7 @@ impl Clarabel {
 /// Clarabel tuned for a tiny dense QP solved thousands of times: no presolve or
 /// equilibration (they would forbid or distort the in-place updates), structural zeros kept
 /// so the sparsity pattern never changes, tolerances of 1e-8.
-fn settings() -> DefaultSettings<Real> {
+fn settings() -> Result<DefaultSettings<Real>, ClarabelFailure> {
     DefaultSettingsBuilder::default()
         .verbose(false)
         .presolve_enable(false)
@@ -908,7 +1024,7 @@ fn settings() -> DefaultSettings<Real> {
         .tol_feas(1e-7)
         .max_iter(100)
         .build()
-        .unwrap_or_default()
+        .map_err(|e| ClarabelFailure::Settings(e.to_string()))
 }
 
 /// Step timings, split by whether Clarabel was needed.
@@ -916,6 +1032,7 @@ fn settings() -> DefaultSettings<Real> {
 struct Timing {
     fast: Vec<Real>,
     clarabel: Vec<Real>,
+    almost_solved: usize,
 }
 
 impl Timing {
@@ -930,6 +1047,7 @@ impl Timing {
         QpStats {
             steps,
             clarabel_steps: self.clarabel.len(),
+            clarabel_almost_solved: self.almost_solved,
             mean_step_time: if steps == 0 { 0.0 } else { total / steps as Real },
             worst_step_time: all.fold(0.0, |a, b| a.max(*b)),
             median_fast_time: median(&self.fast),
@@ -975,7 +1093,8 @@ mod tests {
             let (p, c) = random_problem(&mut rng);
             let exact = p.cholesky().expect("positive definite").solve(&c);
             let bound = Vector7::repeat(10.0 * exact.amax() + 1.0);
-            let x = solver.solve(&p, &c, &-bound, &bound, &[]).expect("solves");
+            let (x, status) = solver.solve(&p, &c, &-bound, &bound, &[]).expect("solves");
+            assert_eq!(status, ClarabelStatus::Solved);
             assert!((x - exact).amax() < 1e-6 * (1.0 + exact.amax()), "{x} vs {exact}");
         }
     }
@@ -992,7 +1111,7 @@ mod tests {
             let rows: Vec<(Vector7, Real)> = (0..2)
                 .map(|_| (Vector7::from_fn(|_, _| rng.random_range(-1.0..1.0)), 0.01))
                 .collect();
-            let x = solver.solve(&p, &c, &lower, &upper, &rows).expect("solves");
+            let (x, _) = solver.solve(&p, &c, &lower, &upper, &rows).expect("solves");
             let feasible = |y: &Vector7, tol: Real| {
                 (0..DOF).all(|i| y[i] >= lower[i] - tol && y[i] <= upper[i] + tol)
                     && rows.iter().all(|(a, b)| a.dot(y) <= b + tol)
@@ -1030,7 +1149,7 @@ mod tests {
             } else {
                 Vec::new()
             };
-            let reference = solver.solve(&p, &c, &lower, &upper, &rows).expect("solves");
+            let (reference, _) = solver.solve(&p, &c, &lower, &upper, &rows).expect("solves");
             if let Some(x) = structured_solve(&ch, &c, &lower, &upper, &rows) {
                 given += 1;
                 // Feasible, no worse than Clarabel's answer, and close to it (Clarabel stops

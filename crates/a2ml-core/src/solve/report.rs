@@ -4,10 +4,11 @@
 use crate::decompose::{ActionType, SegmentPattern};
 use crate::language::{SolverChoice, Space, Variable};
 use crate::math::{Real, UnitQuaternion, Vector3};
+use crate::spelling::spelled;
 use crate::trajectory::{CapsuleDistances, Clearance, Trajectory};
 
 /// How close a goal must be reached.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Tolerance {
     /// Position error (m), default 1 mm.
     pub position: Real,
@@ -31,7 +32,7 @@ impl Default for Tolerance {
 
 /// The final error of one state variable of a segment: distance (m) for Pw, geodesic angle
 /// for Ow and Os, absolute angle difference for θsw and θe (rad).
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct VariableError {
     /// The variable.
     pub variable: Variable,
@@ -42,7 +43,7 @@ pub struct VariableError {
 }
 
 /// Why `auto` went on from the QP to the constrained RRT on a segment with a path.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Fallback {
     /// The QP stopped making progress short of the goal.
@@ -53,28 +54,9 @@ pub enum Fallback {
     QpLeftPath,
 }
 
+spelled!(Fallback, "fallback", [Fallback::QpStalled, Fallback::QpMissedGoal, Fallback::QpLeftPath]);
+
 impl Fallback {
-    /// Every reason.
-    pub const ALL: [Fallback; 3] = [Self::QpStalled, Self::QpMissedGoal, Self::QpLeftPath];
-
-    /// The name in JSON, MCAP and Python: `qp_stalled`, `qp_missed_goal`, `qp_left_path`.
-    pub fn key(self) -> &'static str {
-        match self {
-            Self::QpStalled => "qp_stalled",
-            Self::QpMissedGoal => "qp_missed_goal",
-            Self::QpLeftPath => "qp_left_path",
-        }
-    }
-
-    /// Short form for tables: `qp stalled`, `qp missed goal`, `qp left path`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::QpStalled => "qp stalled",
-            Self::QpMissedGoal => "qp missed goal",
-            Self::QpLeftPath => "qp left path",
-        }
-    }
-
     /// As a sentence: `the QP stalled`.
     pub fn describe(self) -> &'static str {
         match self {
@@ -86,31 +68,35 @@ impl Fallback {
 }
 
 /// Counters and timings of the velocity QP over one segment. The wall-clock timings are not
-/// serialised: plan files hold only what the same task and seed reproduce.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+/// serialised (they read back as 0): plan files hold only what the same task and seed
+/// reproduce.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct QpStats {
     /// Control steps taken.
     pub steps: usize,
     /// Steps that Clarabel solved: a bound or row binds and the exact active-set step did not
     /// settle (see [`crate::solve::qp`]).
     pub clarabel_steps: usize,
+    /// Of those, the steps Clarabel ended `almost_solved` (see [`crate::solve::qp`] on why they
+    /// are accepted).
+    pub clarabel_almost_solved: usize,
     /// Mean wall time of a step (s): Jacobian, distances and the solve.
-    #[serde(skip_serializing)]
+    #[serde(skip)]
     pub mean_step_time: Real,
     /// Longest step (s).
-    #[serde(skip_serializing)]
+    #[serde(skip)]
     pub worst_step_time: Real,
     /// Median time of the steps solved without Clarabel (s): the weighted least-squares step,
     /// or the active-set step on it when a bound or row binds.
-    #[serde(skip_serializing)]
+    #[serde(skip)]
     pub median_fast_time: Real,
     /// Median time of the steps that needed Clarabel (s); 0 when none did.
-    #[serde(skip_serializing)]
+    #[serde(skip)]
     pub median_clarabel_time: Real,
 }
 
 /// One movement segment as solved.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SegmentReport {
     /// The action's name.
     pub action: String,
@@ -182,7 +168,7 @@ pub struct SegmentReport {
 }
 
 /// A planned task: the whole joint trajectory at the output rate and what each segment did.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Plan {
     /// The task's name.
     pub task: String,
@@ -200,8 +186,9 @@ pub struct Plan {
     pub wrist_reference: Vec<(Real, Vector3)>,
     /// The safety distance the solvers kept from obstacles (m).
     pub safety_distance: Real,
-    /// Goals missed beyond tolerance and solver fallbacks, each naming the action and segment.
-    pub warnings: Vec<String>,
+    /// Goals missed beyond tolerance, solver fallbacks and repairs, each with the action and
+    /// segment it names.
+    pub warnings: Vec<Warning>,
     /// What the running segment asked for at each sample of `trajectory` (empty without a
     /// segment): its references at that instant, slowed as the segment was, held at their
     /// ends past T.
@@ -246,4 +233,95 @@ pub struct ReferenceSample {
     /// Its references there.
     #[serde(flatten)]
     pub state: ReferenceState,
+}
+
+/// What a warning is about: the one spelling of its kind in JSON, MCAP and Python, where
+/// warnings are filtered by it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WarningKind {
+    /// An action starts closer to an obstacle than the safety distance (planned anyway, as
+    /// asked).
+    CloseStart,
+    /// The robot's collision geometry is partly made up (skeleton capsules, unread meshes).
+    CollisionGeometry,
+    /// The RRT found no path, and the QP's result is kept.
+    RrtFailed,
+    /// The constrained RRT did no better than the QP, whose result is kept.
+    RrtNoBetter,
+    /// The HAMP motion exceeds a joint speed limit.
+    HampOverSpeed,
+    /// An RRT path was timed slower than the segment's duration to keep the limits.
+    RrtSlowed,
+    /// A segment was slowed down as a whole to keep the limits.
+    SlowedDown,
+    /// A +Tr blend was shortened to keep the limits.
+    BlendShortened,
+    /// The arm came closer to an obstacle than the safety distance.
+    TooClose,
+    /// A goal was missed beyond tolerance.
+    MissedGoal,
+    /// A hard path was left beyond tolerance.
+    LeftPath,
+    /// The output exceeds a joint limit.
+    OverLimits,
+}
+
+spelled!(
+    WarningKind,
+    "warning kind",
+    [
+        WarningKind::CloseStart,
+        WarningKind::CollisionGeometry,
+        WarningKind::RrtFailed,
+        WarningKind::RrtNoBetter,
+        WarningKind::HampOverSpeed,
+        WarningKind::RrtSlowed,
+        WarningKind::SlowedDown,
+        WarningKind::BlendShortened,
+        WarningKind::TooClose,
+        WarningKind::MissedGoal,
+        WarningKind::LeftPath,
+        WarningKind::OverLimits,
+    ]
+);
+
+/// Something a plan did that its user should know: a goal missed, a fallback, a repair.
+/// Typed so that JSON and Python can filter by kind, action and segment; rendered as text
+/// ([`Warning::message`], `Display`) at the edges.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Warning {
+    /// What it is about.
+    pub kind: WarningKind,
+    /// The action it names, if any (the robot's geometry names none).
+    pub action: Option<String>,
+    /// The segment it names within that action (0-based, as [`SegmentReport::segment`]), if
+    /// it names one.
+    pub segment: Option<usize>,
+    /// The warning as one sentence, naming its action and segment (1-based) as the CLI prints
+    /// it.
+    pub message: String,
+}
+
+impl Warning {
+    /// A warning about segment `segment` (0-based) of action `action`.
+    pub fn on_segment(kind: WarningKind, action: &str, segment: usize, message: String) -> Self {
+        Self { kind, action: Some(action.to_owned()), segment: Some(segment), message }
+    }
+
+    /// A warning about a whole action.
+    pub fn on_action(kind: WarningKind, action: &str, message: String) -> Self {
+        Self { kind, action: Some(action.to_owned()), segment: None, message }
+    }
+
+    /// A warning about the whole task.
+    pub fn on_task(kind: WarningKind, message: String) -> Self {
+        Self { kind, action: None, segment: None, message }
+    }
+}
+
+impl std::fmt::Display for Warning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
 }

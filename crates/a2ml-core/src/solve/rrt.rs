@@ -68,7 +68,7 @@ impl Default for RrtOptions {
 }
 
 /// Counters of one search.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct RrtStats {
     /// Random samples drawn.
     pub samples: usize,
@@ -76,8 +76,9 @@ pub struct RrtStats {
     pub nodes: usize,
     /// Configurations checked for collision.
     pub collision_checks: usize,
-    /// Wall time (s); not serialised, so that plan files reproduce byte for byte.
-    #[serde(skip_serializing)]
+    /// Wall time (s); not serialised (it reads back as 0), so that plan files reproduce byte
+    /// for byte.
+    #[serde(skip)]
     pub time: Real,
 }
 

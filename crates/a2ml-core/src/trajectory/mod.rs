@@ -70,12 +70,30 @@ pub enum TrajectoryError {
     Join(#[from] ProfileError),
 }
 
-/// Joint positions and velocities sampled at strictly increasing times.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+/// Joint positions and velocities sampled at strictly increasing times. Deserialising checks
+/// what [`Trajectory::new`] checks.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "Samples")]
 pub struct Trajectory {
     times: Vec<Real>,
     positions: Vec<JointVector>,
     velocities: Vec<JointVector>,
+}
+
+/// A trajectory's fields as serialised, before [`Trajectory::new`] checks them.
+#[derive(serde::Deserialize)]
+struct Samples {
+    times: Vec<Real>,
+    positions: Vec<JointVector>,
+    velocities: Vec<JointVector>,
+}
+
+impl TryFrom<Samples> for Trajectory {
+    type Error = TrajectoryError;
+
+    fn try_from(s: Samples) -> Result<Self, TrajectoryError> {
+        Trajectory::new(s.times, s.positions, s.velocities)
+    }
 }
 
 impl Trajectory {
@@ -374,7 +392,7 @@ pub fn check_within(
 }
 
 /// The smallest clearance along a trajectory, checked at its samples.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Clearance {
     /// Signed distance (m); negative is a penetration depth.
     pub distance: Real,

@@ -26,7 +26,7 @@ decomposed raises :class:`DecomposeError`, one that cannot be solved
 :class:`PlanError`. :class:`Decomposition` and the other ``TypedDict``
 classes describe what :func:`decompose` returns; :class:`VariableError`,
 :class:`Clearance`, :class:`QpStats` and :class:`RrtStats` are the records of a
-:class:`SegmentReport`.
+:class:`SegmentReport`, :class:`PlanWarning` those of :attr:`Plan.warnings`.
 """
 
 from a2ml._a2ml import (
@@ -56,6 +56,7 @@ from a2ml._types import (
     Clearance,
     Decomposition,
     OptReport,
+    PlanWarning,
     PlannedAction,
     PlannedSegment,
     QpStats,
@@ -74,6 +75,7 @@ __all__ = [
     "ParseError",
     "Plan",
     "PlanError",
+    "PlanWarning",
     "PlannedAction",
     "PlannedSegment",
     "QpStats",

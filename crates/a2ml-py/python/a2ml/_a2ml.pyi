@@ -25,7 +25,16 @@ from typing import Any, ClassVar, Literal, final
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from a2ml._types import Clearance, Decomposition, QpStats, RrtStats, VariableError
+from a2ml._types import Clearance, Decomposition, PlanWarning, QpStats, RrtStats, VariableError
+
+# The one spelling of each enum's values (docs/cli.md, "Enum values"); private, so that
+# stubtest does not look for them at run time.
+_Space = Literal["cpsa", "hat"]
+_Variable = Literal["pw", "ow", "swivel", "shoulder_frame", "elbow"]
+_ActionType = Literal["i", "ii", "iii", "iv", "v", "vi", "vii"]
+_Pattern = Literal["path", "goal", "mixed"]
+_Solver = Literal["auto", "qp", "rrt", "map", "gpm", "clik", "pmp", "hamp"]
+_Fallback = Literal["qp_stalled", "qp_missed_goal", "qp_left_path"]
 
 __all__ = [
     "__version__",
@@ -450,15 +459,16 @@ def decompose(task: Task, robot: Robot | None = None) -> Decomposition:
 class SegmentReport:
     """What one movement segment did, as solved; immutable.
 
-    Spelled as :func:`decompose` spells segments: spaces ``"cpsa"`` or
-    ``"hat"``, variables ``"pw"``, ``"ow"``, ``"swivel"``, ``"os"``,
-    ``"elbow"``. Reports compare equal when every field is equal and pickle.
+    Spelled as every output spells them (docs/cli.md): spaces ``"cpsa"`` or
+    ``"hat"``, variables ``"pw"``, ``"ow"``, ``"swivel"``, ``"shoulder_frame"``,
+    ``"elbow"``. Reports compare equal when every field is equal and pickle
+    through the core's serialisation.
     """
 
     __hash__: ClassVar[None]  # type: ignore[assignment]
 
-    def __reduce__(self) -> tuple[Any, tuple[dict[str, Any]]]:
-        """Pickle as its :meth:`to_dict`."""
+    def __reduce__(self) -> tuple[Any, tuple[str, tuple[float, float, float, float, float | None]]]:
+        """Pickle as its JSON and its wall-clock timings."""
 
     def __eq__(self, value: object, /) -> bool:
         """Equal when every field is equal."""
@@ -476,23 +486,25 @@ class SegmentReport:
         """The segment's index within its action, 0-based."""
 
     @property
-    def action_type(self) -> Literal["I", "II", "III", "IV", "V", "VI", "VII"] | None:
-        """The action's type, or None for an action written as explicit segments."""
+    def action_type(self) -> _ActionType | None:
+        """The action's type (the paper's I to VII, in lower case), or None for
+        an action written as explicit segments."""
 
     @property
-    def space(self) -> Literal["cpsa", "hat"]:
+    def space(self) -> _Space:
         """The segment's representation space."""
 
     @property
-    def pattern(self) -> int:
-        """1 (every primitive a path or hold), 2 (every primitive a goal) or 3 (both)."""
+    def pattern(self) -> _Pattern:
+        """The paper's pattern: ``"path"`` (1: every primitive a path or hold),
+        ``"goal"`` (2: every primitive a goal) or ``"mixed"`` (3: both)."""
 
     @property
-    def solver(self) -> str:
+    def solver(self) -> _Solver:
         """The solver that produced the motion (``"qp"``; never ``"auto"``)."""
 
     @property
-    def focus(self) -> list[str]:
+    def focus(self) -> list[_Variable]:
         """The focus of interest: the variables of the segment's featured primitive."""
 
     @property
@@ -514,7 +526,7 @@ class SegmentReport:
     @property
     def errors(self) -> dict[str, VariableError]:
         """The final error of every variable of the segment's space, in the
-        space's order (``pw``, ``ow``, ``swivel`` or ``os``, ``elbow``, ``ow``)."""
+        space's order (``pw``, ``ow``, ``swivel`` or ``shoulder_frame``, ``elbow``, ``ow``)."""
 
     @property
     def path_errors(self) -> dict[str, VariableError]:
@@ -556,7 +568,7 @@ class SegmentReport:
         """The RRT's counters when the RRT solved the segment, else None."""
 
     @property
-    def fallback(self) -> Literal["qp_stalled", "qp_missed_goal", "qp_left_path"] | None:
+    def fallback(self) -> _Fallback | None:
         """Why ``auto`` went on from the QP to the solver named, else None."""
 
     @property
@@ -598,11 +610,15 @@ class Plan:
 
     Every array property builds a fresh float64 array. A plan keeps the
     :class:`Robot` and :class:`Task` it was planned from (the task's source is
-    attached to the MCAP file) and pickles as its data, without planning again.
+    attached to the MCAP file) and pickles as its data (the core's JSON), without
+    planning again.
     """
 
-    def __reduce__(self) -> tuple[Any, tuple[Robot, Task, dict[str, Any]]]:
-        """Pickle as the robot, the task and the plan's data."""
+    def __reduce__(
+        self,
+    ) -> tuple[Any, tuple[Robot, Task, str, list[tuple[float, float, float, float, float | None]]]]:
+        """Pickle as the robot, the task, the plan's JSON and each segment's
+        wall-clock timings (which plan files leave out)."""
 
     @property
     def t(self) -> NDArray[np.float64]:
@@ -630,8 +646,10 @@ class Plan:
         """One report per movement segment, in time order."""
 
     @property
-    def warnings(self) -> list[str]:
-        """Goals missed beyond tolerance, each naming the action and segment."""
+    def warnings(self) -> list[PlanWarning]:
+        """Goals missed beyond tolerance, fallbacks and repairs: each with its
+        ``kind``, the ``action`` and ``segment`` (0-based) it names and its
+        ``message``, in the order the CLI prints them."""
 
     @property
     def reached(self) -> bool:

@@ -4,8 +4,10 @@ as ``NamedTuple`` classes (all re-exported by :mod:`a2ml`).
 
 At run time the decomposition's values are ordinary ``dict`` objects; the
 ``TypedDict`` classes only describe their keys. Joint vectors are float64 arrays of shape (7,) (rad),
-spaces are ``"cpsa"`` or ``"hat"``, variables are spelled as :class:`a2ml.Robot`
-names them (``"pw"``, ``"ow"``, ``"swivel"``, ``"os"``, ``"elbow"``).
+spaces are ``"cpsa"`` or ``"hat"``, variables ``"pw"``, ``"ow"``, ``"swivel"``,
+``"shoulder_frame"``, ``"elbow"``: every enum value is spelled once, as every
+output spells it (docs/cli.md lists them). The records are built by field
+name from the core's serialisation.
 """
 
 # Annotations stay evaluable on Python 3.9 (no ``X | None``), so
@@ -19,6 +21,7 @@ __all__ = [
     "Clearance",
     "Decomposition",
     "OptReport",
+    "PlanWarning",
     "PlannedAction",
     "PlannedSegment",
     "QpStats",
@@ -28,6 +31,20 @@ __all__ = [
 
 # A space is ``"cpsa"`` (Pw, Ow, swivel) or ``"hat"`` (Os, elbow, Ow); spelled
 # out below rather than as an alias, which stubtest cannot compare.
+_WarningKind = Literal[
+    "close_start",
+    "collision_geometry",
+    "rrt_failed",
+    "rrt_no_better",
+    "hamp_over_speed",
+    "rrt_slowed",
+    "slowed_down",
+    "blend_shortened",
+    "too_close",
+    "missed_goal",
+    "left_path",
+    "over_limits",
+]
 
 
 class OptReport(TypedDict):
@@ -48,8 +65,8 @@ class OptReport(TypedDict):
 class PlannedSegment(TypedDict):
     """A movement segment with every value known.
 
-    ``space``; ``pattern`` 1 (every primitive a path or hold), 2 (every
-    primitive a goal) or 3 (both); ``duration`` (s) and ``duration_raised``
+    ``space``; ``pattern`` ``"path"`` (1: every primitive a path or hold),
+    ``"goal"`` (2: every primitive a goal) or ``"mixed"`` (3: both); ``duration`` (s) and ``duration_raised``
     (whether it was raised to respect the joint velocity limits); ``solver``
     (``"auto"``, ``"qp"``, ``"rrt"``, ...); ``relaxed``, the variables the
     table held that had to move for the end to be within the joint limits;
@@ -59,10 +76,10 @@ class PlannedSegment(TypedDict):
     """
 
     space: Literal["cpsa", "hat"]
-    pattern: int
+    pattern: Literal["path", "goal", "mixed"]
     duration: float
     duration_raised: bool
-    solver: str
+    solver: Literal["auto", "qp", "rrt", "map", "gpm", "clik", "pmp", "hamp"]
     relaxed: List[str]
     start: NDArray[np.float64]
     end: NDArray[np.float64]
@@ -73,7 +90,8 @@ class PlannedAction(TypedDict):
     """One action, decomposed.
 
     ``index`` in :attr:`a2ml.Task.actions` and ``name``; the classification:
-    ``type`` (``"I"`` ... ``"VII"``), ``type_number`` (1-7), ``description``
+    ``type`` (the paper's I to VII in lower case, ``"i"`` ... ``"vii"``),
+    ``type_number`` (1-7), ``description``
     (what characterises the type), ``goal_space`` (of G, or of G1 when two
     goals are prioritised), ``secondary_goal_space`` (of G2) and
     ``path_space``, every one None for an explicit action and a space None
@@ -83,7 +101,7 @@ class PlannedAction(TypedDict):
 
     index: int
     name: str
-    type: Optional[str]
+    type: Optional[Literal["i", "ii", "iii", "iv", "v", "vi", "vii"]]
     type_number: Optional[int]
     description: Optional[str]
     goal_space: Optional[Literal["cpsa", "hat"]]
@@ -103,11 +121,12 @@ class Decomposition(TypedDict):
 
 
 class VariableError(NamedTuple):
-    """The error of one state variable at a segment's end, or its largest
+    """The error of one state ``variable`` at a segment's end, or its largest
     deviation from its path: distance (m) for ``pw``, geodesic angle (rad)
-    for ``ow`` and ``os``, absolute difference (rad) for ``swivel`` and
-    ``elbow``; ``within`` the tolerance (1 mm, 1 degree)."""
+    for ``ow`` and ``shoulder_frame``, absolute difference (rad) for
+    ``swivel`` and ``elbow``; ``within`` the tolerance (1 mm, 1 degree)."""
 
+    variable: Literal["pw", "ow", "swivel", "shoulder_frame", "elbow"]
     error: float
     within: bool
 
@@ -137,12 +156,28 @@ class RrtStats(NamedTuple):
 class QpStats(NamedTuple):
     """Counters and timings of the velocity QP over a segment: control
     ``steps``, the ``clarabel_steps`` where a bound or collision row was
-    binding, the mean and longest step (s), and the median time of the steps
-    solved by weighted least squares and by Clarabel (s; 0 when none)."""
+    binding (``clarabel_almost_solved`` of them solved to Clarabel's reduced
+    accuracy), the mean and longest step (s), and the median time of the
+    steps solved by weighted least squares and by Clarabel (s; 0 when none)."""
 
     steps: int
     clarabel_steps: int
+    clarabel_almost_solved: int
     mean_step_time: float
     worst_step_time: float
     median_fast_time: float
     median_clarabel_time: float
+
+
+class PlanWarning(NamedTuple):
+    """Something a plan did that its user should know: its ``kind``, the
+    ``action`` and ``segment`` (0-based, as :attr:`a2ml.SegmentReport.segment`)
+    it names, if any, and the ``message`` the CLI prints (also ``str()``)."""
+
+    kind: _WarningKind
+    action: Optional[str]
+    segment: Optional[int]
+    message: str
+
+    def __str__(self) -> str:
+        return self.message
