@@ -1,4 +1,4 @@
-//! `Plan.plot`, `Plan.to_svg`, `Plan.to_html`, `Plan.write_report` and `Plan._repr_html_`:
+//! `Plan.plot` (SVG or PNG), `Plan.to_svg`, `Plan.to_html`, `Plan.write_report` and `Plan._repr_html_`:
 //! the core's pictures and report of a plan (`a2ml_core::output::plot` and `::report`),
 //! drawn with the GIL released. Kinds are named as `a2ml plot --kind` names them.
 
@@ -42,7 +42,8 @@ pub(crate) fn svg(
     py.detach(|| plot::plot_svg(robot, task, plan, kind)).map(|p| p.svg).map_err(refused)
 }
 
-/// Writes the SVG document of `kind` to `path`.
+/// Writes the picture of `kind` to `path`: PNG for a `.png` name, else SVG; `width` pixels
+/// wide (as drawn when `None`).
 pub(crate) fn write(
     py: Python<'_>,
     path: &Path,
@@ -50,8 +51,16 @@ pub(crate) fn write(
     task: &Task,
     plan: &Plan,
     kind: PlotKind,
+    width: Option<u32>,
 ) -> PyResult<()> {
-    py.detach(|| plot::write_plot(path, robot, task, plan, kind)).map_err(CoreError::from)?;
+    if let Some(w) = width.filter(|w| *w == 0 || *w > plot::MAX_WIDTH) {
+        return Err(PyValueError::new_err(format!(
+            "width is 1 to {} pixels, not {w}",
+            plot::MAX_WIDTH
+        )));
+    }
+    py.detach(|| plot::write_plot(path, robot, task, plan, kind, width))
+        .map_err(CoreError::from)?;
     Ok(())
 }
 
@@ -91,20 +100,22 @@ pub(crate) fn notebook(
     py.detach(|| report::notebook_html(robot, task, plan)).map_err(refused)
 }
 
-/// The plan's per-sample references and distances, as JSON text for pickling.
+/// The plan's per-sample references and distances and its swivel maps, as JSON text for
+/// pickling.
 pub(crate) fn per_sample_state(plan: &Plan) -> PyResult<String> {
-    let parts = (&plan.references, &plan.reference_ends, &plan.distances);
+    let parts = (&plan.references, &plan.reference_ends, &plan.distances, &plan.swivel_maps);
     serde_json::to_string(&parts).map_err(refused)
 }
 
-/// `plan` with the references and distances of [`per_sample_state`]'s text.
+/// `plan` with the references, distances and swivel maps of [`per_sample_state`]'s text.
 pub(crate) fn with_per_sample_state(mut plan: Plan, state: &Bound<'_, PyAny>) -> PyResult<Plan> {
     let text: String = state.extract()?;
-    let (references, reference_ends, distances) = serde_json::from_str(&text)
+    let (references, reference_ends, distances, swivel_maps) = serde_json::from_str(&text)
         .map_err(|e| PyValueError::new_err(format!("invalid plan state: {e}")))?;
     plan.references = references;
     plan.reference_ends = reference_ends;
     plan.distances = distances;
+    plan.swivel_maps = swivel_maps;
     Ok(plan)
 }
 

@@ -17,12 +17,14 @@ use super::constrained_rrt::constrained_rrt_monitored;
 use super::control::{BaselineOptions, ControlError, ControlOptions, ControlRun};
 use super::hamp::{HampOptions, HandoverTarget, plan_handover};
 use super::judge::{self, Judgement};
-use super::map::{MapError, MapOptions, map_segment};
+use super::map::{MapError, MapOptions, MapSummary, map_segment};
 use super::monitor::{Monitor, deadline_after};
 use super::problem::{Component, SegmentProblem};
 use super::qp::{self, QpError, QpOptions};
 use super::references::{Placed, reference_ends, reference_samples};
-use super::report::{Fallback, Plan, QpStats, SegmentReport, Tolerance, VariableError};
+use super::report::{
+    Fallback, Plan, QpStats, SegmentReport, SegmentSwivelMap, Tolerance, VariableError,
+};
 use super::rrt::{RrtError, RrtOptions, RrtStats, rrt_connect_monitored};
 use super::timing::{TimedPath, time_constrained, time_parameterise};
 use super::{clik, gpm, pmp};
@@ -329,8 +331,12 @@ pub fn plan_with_progress(
     let reference_ends = reference_ends(robot, &placed);
     let mut segments = Vec::with_capacity(state.pieces.len());
     let mut wrist_reference = Vec::new();
+    let mut swivel_maps = Vec::new();
     for piece in state.pieces {
         wrist_reference.extend(piece.reference.iter().map(|(t, p)| (piece.start + t, *p)));
+        if let Some(map) = piece.swivel_map {
+            swivel_maps.push(SegmentSwivelMap { segment: segments.len(), map });
+        }
         segments.push(piece.report);
     }
     let distances = capsule_distances(&whole, robot, &task_b.scene, |sample, obstacle| {
@@ -356,6 +362,7 @@ pub fn plan_with_progress(
         references,
         reference_ends,
         distances,
+        swivel_maps,
     })
 }
 
@@ -379,6 +386,8 @@ struct Piece {
     stretch: Real,
     /// Start in the plan's time (s), once joined.
     start: Real,
+    /// The map and profile, when the swivel map solved the segment.
+    swivel_map: Option<MapSummary>,
 }
 
 impl Piece {
@@ -491,6 +500,7 @@ impl Solver<'_> {
                 problem: job.problem,
                 stretch: 1.0,
                 start: 0.0,
+                swivel_map: solution.swivel_map,
             });
             let done = self.pieces.len();
             progress(&Progress {
@@ -755,6 +765,7 @@ impl Solver<'_> {
             qp: solution.stats,
             rrt: None,
             fallback: None,
+            swivel_map: None,
         })
     }
 
@@ -799,13 +810,15 @@ impl Solver<'_> {
             safety_distance: self.options.safety_distance,
             ..self.options.map.clone()
         };
-        let (_, profile) = map_segment(self.robot, &obstacles, &job.problem, &self.q, &options)
+        let (map, profile) = map_segment(self.robot, &obstacles, &job.problem, &self.q, &options)
             .map_err(|source| SolveError::Map {
-                action: job.action.name.clone(),
-                segment: job.k,
-                source,
-            })?;
-        Ok(self.judged(job, SolverChoice::Map, profile.trajectory, 0.0, false, None))
+            action: job.action.name.clone(),
+            segment: job.k,
+            source,
+        })?;
+        let summary = MapSummary::new(&map, Some(&profile));
+        let solved = self.judged(job, SolverChoice::Map, profile.trajectory, 0.0, false, None);
+        Ok(Solved { swivel_map: Some(summary), ..solved })
     }
 
     /// A segment by one of the baselines, judged like every other solver: the segment's own
@@ -906,6 +919,7 @@ impl Solver<'_> {
             qp: QpStats::default(),
             rrt,
             fallback: None,
+            swivel_map: None,
         }
     }
 
@@ -1112,6 +1126,8 @@ struct Solved {
     rrt: Option<RrtStats>,
     /// Why `auto` went on from the QP to this solver.
     fallback: Option<Fallback>,
+    /// The map and profile, when the swivel map solved it.
+    swivel_map: Option<MapSummary>,
 }
 
 /// The trajectory with `offset` added to its times.
