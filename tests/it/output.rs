@@ -135,6 +135,7 @@ fn plan(robot: &Robot) -> Plan {
                 .map(|k| (k % 10 != 3).then_some(0.1 + k as Real * 1e-3))
                 .collect(),
         }],
+        swivel_maps: Vec::new(),
     }
 }
 

@@ -383,3 +383,174 @@ fn the_recorded_distances_are_the_distances_of_the_capsules_to_the_obstacles() {
     }
     assert!(checked >= 20, "{checked} pairs checked");
 }
+
+#[test]
+fn one_distance_pass_gives_the_per_obstacle_distances_and_the_clearance() {
+    use a2ml::collision::{CollisionScene, DistanceOptions, distances};
+    use a2ml::trajectory::{distance_pass, min_clearance};
+    for name in ["push_box_aside_coman.a2ml", "construct_scene.a2ml", "swivel_map_spheres.a2ml"] {
+        let (robot, task, plan) = planned(&example(name));
+        let scene = task.in_base_frame(&robot.structure.shoulder_in_base_link).scene;
+        assert!(!scene.is_empty(), "{name} has obstacles");
+        // Touching the first obstacle during the first third, as a contact action would.
+        let third = plan.trajectory.len() / 3;
+        let touched = |sample: usize, obstacle: &str| sample < third && obstacle == scene[0].name;
+        let pass = distance_pass(&plan.trajectory, &robot, &scene, touched);
+        // Each obstacle on its own: the query per sample and obstacle the pass replaces.
+        let options = DistanceOptions { influence: 1e3 };
+        for (k, q) in plan.trajectory.positions().iter().enumerate() {
+            let pose = a2ml::kinematics::arm_pose(&robot, q);
+            for series in &pass.distances {
+                let obstacle = scene.iter().find(|o| o.name == series.obstacle).expect("named");
+                let alone = CollisionScene::new(std::slice::from_ref(obstacle));
+                let expected = if touched(k, &obstacle.name) {
+                    None
+                } else {
+                    distances(&robot, &pose, &alone, &options)
+                        .into_iter()
+                        .find(|p| p.obstacle_frame.is_none() && p.link == series.capsule)
+                        .map(|p| p.distance)
+                };
+                assert_eq!(
+                    series.distance[k], expected,
+                    "{name}: {} at sample {k}",
+                    series.capsule
+                );
+            }
+        }
+        // Without contact, its clearance is the bounding-sphere search's, to the bit.
+        let untouched = distance_pass(&plan.trajectory, &robot, &scene, |_, _| false);
+        let searched = min_clearance(&plan.trajectory, &robot, &CollisionScene::new(&scene));
+        assert_eq!(untouched.clearance, searched, "{name}");
+        // With contact, the touched samples leave out that obstacle and nothing else.
+        let clearance = pass.clearance.expect("pairs are measured");
+        let smallest = pass
+            .distances
+            .iter()
+            .flat_map(|s| s.distance.iter().flatten().copied())
+            .fold(Real::INFINITY, Real::min);
+        assert!(clearance.distance <= smallest, "{name}: self pairs count too");
+        assert_eq!(untouched.distances.len(), pass.distances.len());
+    }
+}
+
+#[test]
+fn the_plan_keeps_the_swivel_map_its_solver_computed() {
+    use a2ml::decompose::DecomposeOptions;
+    use a2ml::language::SolverChoice;
+    use a2ml::solve::map::{Cell, MapOptions, MapSummary, segment_map};
+    let (robot, task, plan) = planned(&example("swivel_map_spheres.a2ml"));
+    let mapped: Vec<usize> = (0..plan.segments.len())
+        .filter(|&k| plan.segments[k].solver == SolverChoice::Map)
+        .collect();
+    assert!(!mapped.is_empty(), "the example is solved by the map");
+    let kept: Vec<usize> = plan.swivel_maps.iter().map(|m| m.segment).collect();
+    assert_eq!(kept, mapped, "one map per segment the map solved");
+    // The first segment starts where the decomposition starts: `a2ml map`'s map is the plan's.
+    let first = &plan.swivel_maps[0];
+    let report = &plan.segments[first.segment];
+    let options = MapOptions {
+        safety_distance: PlanOptions::default().safety_distance,
+        ..MapOptions::default()
+    };
+    let fresh = segment_map(
+        &robot,
+        &task,
+        &report.action,
+        report.segment,
+        &DecomposeOptions::default(),
+        &options,
+    )
+    .expect("the map builds");
+    let profile = fresh.profile.as_ref().expect("a profile");
+    assert_eq!(first.map, MapSummary::new(&fresh.map, Some(profile)));
+    // The runs give every cell back, free ones included.
+    let summary = &first.map;
+    assert_eq!(summary.angle_steps, fresh.map.angles.len());
+    let mut blocked = 0;
+    for i in 0..fresh.map.times.len() {
+        for j in 0..fresh.map.angles.len() {
+            assert_eq!(summary.cell(i, j), fresh.map.cell(i, j), "cell ({i}, {j})");
+            blocked += usize::from(fresh.map.cell(i, j) != Cell::Free);
+        }
+    }
+    assert!(blocked > 0, "the spheres block some cells");
+    assert!(summary.runs.len() < blocked, "runs are fewer than the cells they cover");
+    // The profile kept is the solver's, thinned: its ends and points on it.
+    let (times, swivel) = (profile.trajectory.times(), &profile.swivel);
+    assert_eq!(summary.profile.first(), Some(&(times[0], swivel[0])));
+    assert_eq!(summary.profile.last(), Some(&(times[times.len() - 1], swivel[swivel.len() - 1])));
+    assert!(summary.profile.len() <= 2 * summary.times.len() + 1);
+    for &(t, a) in &summary.profile {
+        let k = times.iter().position(|s| *s == t).expect("a sample's time");
+        assert_eq!(swivel[k], a);
+    }
+}
+
+#[test]
+fn the_report_draws_the_swivel_map_of_each_segment_the_map_solved() {
+    use a2ml::output::report::{ReportInput, report_html};
+    let (robot, task, plan) = planned(&example("swivel_map_spheres.a2ml"));
+    let input =
+        ReportInput { robot: &robot, task: &task, source: "", plan: &plan, decomposition: None };
+    let html = report_html(&input).expect("the report");
+    let section = &html[html.find("<section id=\"swivel-maps\">").expect("a map section")..];
+    let section = &section[..section.find("</section>").expect("its end")];
+    assert_eq!(section.matches("<figure class=\"map\"").count(), plan.swivel_maps.len());
+    for name in ["sphere1", "swivel profile", "swivel angle θsw (deg)"] {
+        assert!(section.contains(name), "the map figure shows {name}");
+    }
+    // The figure is `a2ml map`'s, scaled to the page.
+    let entry = &plan.swivel_maps[0];
+    let s = &plan.segments[entry.segment];
+    let title = format!("{} — action {}, segment {}", plan.task, s.action, s.segment + 1);
+    let figure = a2ml::output::swivel_map_svg(&entry.map, &title).expect("draws");
+    let body = &figure[figure.find('>').expect("the root") + 1..];
+    assert!(section.contains(body), "the report embeds the map figure");
+    // A plan the map did not solve has no such section.
+    let (robot, task, plan) = planned(&example("construct_scene.a2ml"));
+    assert!(plan.swivel_maps.is_empty());
+    let input =
+        ReportInput { robot: &robot, task: &task, source: "", plan: &plan, decomposition: None };
+    assert!(!report_html(&input).expect("the report").contains("swivel-maps"));
+}
+
+#[test]
+fn a_png_picture_decodes_at_the_size_asked_with_its_text_drawn() {
+    use a2ml::output::plot::{ImageFormat, encode, write_plot};
+    let (robot, task, plan) = planned(&example("type_iv_forward_bar.a2ml"));
+    let picture = plot_svg(&robot, &task, &plan, PlotKind::Joints).expect("draws");
+    let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join("joints.png");
+    write_plot(&path, &robot, &task, &plan, PlotKind::Joints, Some(640)).expect("written");
+    let bytes = std::fs::read(&path).expect("read back");
+    assert_eq!(bytes[..8], *b"\x89PNG\r\n\x1a\n");
+    let image = Pixmap::decode_png(&bytes).expect("decodes");
+    let height = (f64::from(picture.size.1) * 640.0 / f64::from(picture.size.0)).round() as u32;
+    assert_eq!((image.width(), image.height()), (640, height));
+    let share = ink(&image);
+    assert!(share > 0.02, "only {share} of the image is drawn");
+    // At its own size, the shapes are the SVG's (rendered here without any font) and the text
+    // comes on top: more ink, and every pixel the fontless render inks is inked too.
+    let own = Pixmap::decode_png(&encode(&picture, ImageFormat::Png, None).expect("encodes"))
+        .expect("decodes");
+    let fontless = render(&picture);
+    assert_eq!((own.width(), own.height()), picture.size);
+    assert!(ink(&own) > ink(&fontless) + 0.002, "{} vs {}", ink(&own), ink(&fontless));
+    let white = |p: &resvg::tiny_skia::PremultipliedColorU8| {
+        (p.red(), p.green(), p.blue()) == (255, 255, 255)
+    };
+    let lost = own
+        .pixels()
+        .iter()
+        .zip(fontless.pixels())
+        .filter(|(with_text, shapes)| white(with_text) && !white(shapes))
+        .count();
+    assert_eq!(lost, 0, "every pixel the shapes ink stays inked under the text");
+    // An SVG asked at a width keeps its drawing and scales it.
+    let svg = encode(&picture, ImageFormat::Svg, Some(500)).expect("scales");
+    let svg = String::from_utf8(svg).expect("text");
+    let scaled = Tree::from_str(&svg, &Options::default()).expect("parses").size().to_int_size();
+    let expected = (f64::from(picture.size.1) * 500.0 / f64::from(picture.size.0)).round() as u32;
+    assert_eq!((scaled.width(), scaled.height()), (500, expected));
+    assert!(write_plot(&path, &robot, &task, &plan, PlotKind::Joints, Some(0)).is_err());
+}

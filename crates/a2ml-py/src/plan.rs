@@ -361,11 +361,12 @@ impl PyPlan {
         crate::plot::svg(py, robot, task, &self.plan, crate::plot::kind(kind)?)
     }
 
-    /// Writes the plan drawn as `kind` (as [`Self::to_svg`]) to an SVG file.
-    #[pyo3(signature = (path, kind="all"))]
-    fn plot(&self, py: Python<'_>, path: PathBuf, kind: &str) -> PyResult<()> {
+    /// Writes the plan drawn as `kind` (as [`Self::to_svg`]) to an SVG file, or a PNG image
+    /// for a `.png` path, `width` pixels wide.
+    #[pyo3(signature = (path, kind="all", width=None))]
+    fn plot(&self, py: Python<'_>, path: PathBuf, kind: &str, width: Option<u32>) -> PyResult<()> {
         let (robot, task) = (&self.robot.get().robot, &self.task.get().task);
-        crate::plot::write(py, &path, robot, task, &self.plan, crate::plot::kind(kind)?)
+        crate::plot::write(py, &path, robot, task, &self.plan, crate::plot::kind(kind)?, width)
     }
 
     /// The self-contained HTML report: summary, segments, motion playback, plots, task.

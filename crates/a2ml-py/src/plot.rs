@@ -1,4 +1,4 @@
-//! `Plan.plot`, `Plan.to_svg`, `Plan.to_html`, `Plan.write_report` and `Plan._repr_html_`:
+//! `Plan.plot` (SVG or PNG), `Plan.to_svg`, `Plan.to_html`, `Plan.write_report` and `Plan._repr_html_`:
 //! the core's pictures and report of a plan (`a2ml_core::output::plot` and `::report`),
 //! drawn with the GIL released. Kinds are named as `a2ml plot --kind` names them.
 
@@ -42,7 +42,8 @@ pub(crate) fn svg(
     py.detach(|| plot::plot_svg(robot, task, plan, kind)).map(|p| p.svg).map_err(refused)
 }
 
-/// Writes the SVG document of `kind` to `path`.
+/// Writes the picture of `kind` to `path`: PNG for a `.png` name, else SVG; `width` pixels
+/// wide (as drawn when `None`).
 pub(crate) fn write(
     py: Python<'_>,
     path: &Path,
@@ -50,8 +51,16 @@ pub(crate) fn write(
     task: &Task,
     plan: &Plan,
     kind: PlotKind,
+    width: Option<u32>,
 ) -> PyResult<()> {
-    py.detach(|| plot::write_plot(path, robot, task, plan, kind)).map_err(CoreError::from)?;
+    if let Some(w) = width.filter(|w| *w == 0 || *w > plot::MAX_WIDTH) {
+        return Err(PyValueError::new_err(format!(
+            "width is 1 to {} pixels, not {w}",
+            plot::MAX_WIDTH
+        )));
+    }
+    py.detach(|| plot::write_plot(path, robot, task, plan, kind, width))
+        .map_err(CoreError::from)?;
     Ok(())
 }
 

@@ -11,7 +11,7 @@ use a2ml_core::RobotOptions;
 use a2ml_core::decompose::DecomposeOptions;
 use a2ml_core::output::{swivel_map_svg, write_text};
 use a2ml_core::solve::SolveError;
-use a2ml_core::solve::map::{Cell, MapError, MapOptions, SegmentMapError, segment_map};
+use a2ml_core::solve::map::{Cell, MapError, MapOptions, MapSummary, SegmentMapError, segment_map};
 use a2ml_core::solve::qp::QpOptions;
 
 use crate::error::CliError;
@@ -73,7 +73,8 @@ pub fn run(args: &MapArgs) -> Result<(), CliError> {
         segment_map(&robot, &task, &args.action, k, &DecomposeOptions::default(), &options)
             .map_err(|e| map_error(&args.file, e))?;
     let title = format!("{} — action {}, segment {}", task.name, args.action, args.segment);
-    let svg = swivel_map_svg(&segment.map, segment.profile.as_ref().ok(), &title)
+    let summary = MapSummary::new(&segment.map, segment.profile.as_ref().ok());
+    let svg = swivel_map_svg(&summary, &title)
         .map_err(|e| CliError::Planning(format!("cannot draw the map: {e}")))?;
     let path = args.output.clone().unwrap_or_else(|| default_output(&args.file));
     write_text(&path, &svg).map_err(|e| CliError::Io(e.to_string()))?;

@@ -1,5 +1,5 @@
 //! `a2ml plot`: plans a task file (as `a2ml plan` does), or reads a plan's MCAP recording, and
-//! draws the plan as an SVG picture through the core's
+//! draws the plan as an SVG or PNG picture (by the output's extension) through the core's
 //! [`output::plot`](a2ml_core::output::plot): one kind of chart, or every kind on one page.
 
 use std::path::{Path, PathBuf};
@@ -8,7 +8,7 @@ use clap::Args;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 
 use a2ml_core::language::Task;
-use a2ml_core::output::plot::{PlotData, PlotKind, write_plot, write_plot_data};
+use a2ml_core::output::plot::{MAX_WIDTH, PlotData, PlotKind, write_plot, write_plot_data};
 use a2ml_core::output::{RecordedPlan, read_mcap};
 use a2ml_core::solve::{self, Plan, PlanOptions};
 use a2ml_core::{Robot, RobotOptions};
@@ -22,7 +22,11 @@ use crate::output;
 Examples:
   a2ml plot examples/type_iv_forward_bar.a2ml -o forward_bar.svg
   a2ml plot task.a2ml -o joints.svg --kind joints
+  a2ml plot task.a2ml -o joints.png --kind joints --width 1600
   a2ml plot plan.mcap -o plan.svg      (a plan written by `a2ml plan --mcap`)
+
+An output ending in .png is a PNG image (its text in the font the library
+embeds, no system font read); any other is an SVG document.
 
 Kinds: joints (positions, limits shaded, segment boundaries numbered),
 velocities (and accelerations, against the speed limits), featured (each
@@ -39,9 +43,12 @@ pub struct PlotArgs {
     /// The task file (it is planned first), or a plan's .mcap recording.
     #[arg(value_name = "TASK.a2ml|PLAN.mcap")]
     pub file: PathBuf,
-    /// The SVG file to write.
-    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
+    /// The picture to write: PNG for a .png name, else SVG.
+    #[arg(short = 'o', long = "output", value_name = "OUT.svg|OUT.png")]
     pub output: PathBuf,
+    /// The picture's width in pixels, its height in proportion [default: as drawn].
+    #[arg(long, value_name = "PX")]
+    pub width: Option<u32>,
     /// What to draw.
     #[arg(long, value_name = "KIND", default_value = "all", value_parser = kind_parser())]
     pub kind: PlotKind,
@@ -113,11 +120,22 @@ pub fn run(args: &PlotArgs) -> Result<(), CliError> {
     if is_recording(&args.file) {
         return plot_recording(args);
     }
+    check_width(args.width)?;
     let planned = plan_file(&args.file, args.seed)?;
-    write_plot(&args.output, &planned.robot, &planned.task, &planned.plan, args.kind)
+    write_plot(&args.output, &planned.robot, &planned.task, &planned.plan, args.kind, args.width)
         .map_err(|e| CliError::Io(e.to_string()))?;
     output::print(&format!("wrote  {}\n", args.output.display()))?;
     missed(&planned.plan, "the picture")
+}
+
+/// [`CliError::Input`] for a `--width` no picture can have, before anything is planned.
+fn check_width(width: Option<u32>) -> Result<(), CliError> {
+    match width {
+        Some(w) if w == 0 || w > MAX_WIDTH => {
+            Err(CliError::Input(format!("--width is 1 to {MAX_WIDTH} pixels, not {w}")))
+        }
+        _ => Ok(()),
+    }
 }
 
 /// Whether `file` is an MCAP recording (by its extension).
@@ -141,9 +159,11 @@ pub fn recorded_robot(file: &Path, recorded: &RecordedPlan) -> Result<Robot, Cli
 
 /// `a2ml plot PLAN.mcap`: draws the recorded plan, exit code 3 when a segment missed.
 fn plot_recording(args: &PlotArgs) -> Result<(), CliError> {
+    check_width(args.width)?;
     let recorded = read_mcap(&args.file)?;
     let robot = recorded_robot(&args.file, &recorded)?;
     let data = PlotData::recorded(&robot, &recorded.obstacles, &recorded);
-    write_plot_data(&args.output, &data, args.kind).map_err(|e| CliError::Io(e.to_string()))?;
+    write_plot_data(&args.output, &data, args.kind, args.width)
+        .map_err(|e| CliError::Io(e.to_string()))?;
     output::print(&format!("wrote  {}\n", args.output.display()))
 }

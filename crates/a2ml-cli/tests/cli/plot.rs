@@ -206,3 +206,66 @@ fn a_plan_recording_plots_as_its_task_does() {
     let out = a2ml(&["plot", &other.to_string_lossy(), "-o", &dir.join("x.svg").to_string_lossy()]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
 }
+
+/// Width and height of a PNG file, from its IHDR chunk.
+fn png_size(bytes: &[u8]) -> (u32, u32) {
+    assert_eq!(bytes[..8], *b"\x89PNG\r\n\x1a\n", "a PNG signature");
+    assert_eq!(&bytes[12..16], b"IHDR");
+    let word = |at: usize| u32::from_be_bytes(bytes[at..at + 4].try_into().expect("4 bytes"));
+    (word(16), word(20))
+}
+
+#[test]
+fn a_png_name_writes_a_png_image_at_the_width_asked() {
+    let dir = scratch("plot", "png");
+    let file = example_path("construct_path_line.a2ml");
+    let (png, svg) = (dir.join("joints.png"), dir.join("joints.svg"));
+    let out = a2ml(&["plot", &file, "-o", &svg.to_string_lossy(), "--kind", "joints"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let out = a2ml(&["plot", &file, "-o", &png.to_string_lossy(), "--kind", "joints"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    // As drawn: the SVG's own size.
+    let text = fs::read_to_string(&svg).expect("svg");
+    let attribute = |name: &str| -> u32 {
+        let at = text.find(&format!("{name}=\"")).expect("sized") + name.len() + 2;
+        text[at..at + text[at..].find('"').expect("quoted")].parse().expect("a number")
+    };
+    let own = (attribute("width"), attribute("height"));
+    assert_eq!(png_size(&fs::read(&png).expect("png")), own);
+    let out = a2ml(&["plot", &file, "-o", &png.to_string_lossy(), "--width", "480"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let (w, h) = png_size(&fs::read(&png).expect("png"));
+    assert_eq!(w, 480);
+    assert!(h > 100, "the whole page in proportion: {h} px");
+    // A width no picture has is refused before anything is planned, nothing written.
+    for width in ["0", "100000"] {
+        let other = dir.join(format!("w{width}.png"));
+        let out = a2ml(&["plot", &file, "-o", &other.to_string_lossy(), "--width", width]);
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        assert!(stderr(&out).contains("--width"), "{}", stderr(&out));
+        assert!(!other.exists());
+    }
+}
+
+#[test]
+fn the_report_shows_the_swivel_map_of_a_map_segment() {
+    let dir = scratch("plot", "report_map");
+    let html = dir.join("report.html");
+    let file = example_path("swivel_map_spheres.a2ml");
+    let out = a2ml(&["report", &file, "-o", &html.to_string_lossy()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let page = fs::read_to_string(&html).expect("the report");
+    assert!(page.contains("<section id=\"swivel-maps\">"));
+    assert!(page.contains("<figure class=\"map\" data-segment=\"0\">"));
+    assert_eq!(external_references(&page), Vec::<String>::new());
+    let json = dir.join("plan.json");
+    let out = a2ml(&["plan", &file, "--json", &json.to_string_lossy()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let plan: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&json).expect("json")).expect("JSON");
+    let maps = plan["swivel_maps"].as_array().expect("the plan keeps its maps");
+    assert_eq!(maps.len(), 1);
+    assert_eq!(maps[0]["segment"], 0);
+    assert_eq!(maps[0]["angle_steps"], 360);
+    assert!(!maps[0]["runs"].as_array().expect("runs").is_empty());
+}

@@ -53,7 +53,9 @@ pub fn normalised_jerk<const N: usize>(times: &[Real], velocities: &[SVector<Rea
 /// 0 for a profile that never moves.
 pub fn speed_peaks(speeds: &[Real]) -> usize {
     let top = speeds.iter().copied().fold(0.0, Real::max);
-    if !(top > 0.0) {
+    // `max` passes over NaN speeds, so the top is 0 for a profile that never moves or is all
+    // NaN; NaN is tested all the same, so that no other fold can let one through.
+    if top.is_nan() || top <= 0.0 {
         return 0;
     }
     let threshold = PEAK_PROMINENCE * top;
@@ -152,6 +154,7 @@ mod tests {
             one.iter().enumerate().map(|(k, s)| s + 0.01 * (k as Real).sin()).collect();
         assert_eq!(speed_peaks(&rippled), 1);
         assert_eq!(speed_peaks(&[0.0; 5]), 0);
+        assert_eq!(speed_peaks(&[Real::NAN; 3]), 0);
         // A plateau is one peak; a profile ending at speed still has its peak.
         assert_eq!(speed_peaks(&[0.0, 1.0, 1.0, 1.0, 0.0]), 1);
         assert_eq!(speed_peaks(&[0.0, 0.5, 1.0]), 1);

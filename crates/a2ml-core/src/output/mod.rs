@@ -1,5 +1,5 @@
 //! Writing a [`Plan`] to files (docs/design.md §6): an MCAP recording for Foxglove, a CSV table
-//! of the joint trajectory, the plan as JSON, a Parquet table of the samples, SVG pictures ([`plot`]) and an HTML report
+//! of the joint trajectory, the plan as JSON, a Parquet table of the samples, SVG and PNG pictures ([`plot`]) and an HTML report
 //! ([`report`]).
 //!
 //! Entry points: [`write_mcap`], [`write_csv`], [`write_json`], [`write_parquet`], [`plot::write_plot`],
@@ -241,8 +241,16 @@ pub fn parquet_bytes(
 /// # Errors
 /// [`OutputError::Io`] when the file cannot be written; the target is then left untouched.
 pub fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
+    write_bytes(path, text.as_bytes())
+}
+
+/// Writes `bytes` to `path` through a temporary file (PNG images).
+///
+/// # Errors
+/// As [`write_text`].
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     atomic::write_atomically(path, |out| {
-        std::io::Write::write_all(out, text.as_bytes())?;
+        std::io::Write::write_all(out, bytes)?;
         Ok(())
     })
 }

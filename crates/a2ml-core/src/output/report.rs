@@ -1,8 +1,9 @@
 //! A plan as one self-contained HTML page (issue 18): the task text, its decomposition, the
 //! per-segment table with statuses and warnings, the human-likeness measures (Fitts, HAMP
-//! patterns, RULA, speed shape, jerk: `a2ml analyze`'s), every plot, and the motion itself (the arm's
-//! capsules and the obstacles in a front and a top view) played back with a play button and a
-//! time slider that also marks the time on the plots.
+//! patterns, RULA, speed shape, jerk: `a2ml analyze`'s), every plot, the swivel map of each
+//! segment the map solver planned, and the motion itself (the arm's capsules and the
+//! obstacles in a front and a top view) played back with a play button and a time slider that
+//! also marks the time on the plots.
 //!
 //! Entry points: [`report_html`], [`write_report`]. Nothing is fetched: styles, pictures and
 //! the small script are inline; light and dark follow `prefers-color-scheme`.
@@ -75,6 +76,7 @@ pub fn report_html(input: &ReportInput) -> Result<String, PlotError> {
          motion above.</p>\n<div class=\"figure\">{}</div>\n</section>\n",
         with_time_marks(&picture.svg, &picture.panels)
     );
+    swivel_maps(&mut out, plan)?;
     if let Some(text) = input.decomposition {
         let _ = write!(
             out,
@@ -302,6 +304,52 @@ fn human_likeness(out: &mut String, input: &ReportInput) {
         measures_row(out, m);
     }
     out.push_str("</tbody>\n</table>\n</div>\n</section>\n");
+}
+
+/// The swivel map of every segment the map solver planned: the figure `a2ml map` draws, from
+/// what the plan kept of the map.
+fn swivel_maps(out: &mut String, plan: &Plan) -> Result<(), PlotError> {
+    if plan.swivel_maps.is_empty() {
+        return Ok(());
+    }
+    out.push_str(
+        "<section id=\"swivel-maps\">\n<h2>Swivel maps</h2>\n<p>Each segment the swivel map \
+         solved: time from the segment's start as solved (s) against the swivel angle; coloured \
+         cells are forbidden (by an obstacle, the joint limits or self-collision), the line is \
+         the profile the planner chose through the free ones.</p>\n",
+    );
+    for entry in &plan.swivel_maps {
+        let Some(s) = plan.segments.get(entry.segment) else { continue };
+        let title = format!("{} — action {}, segment {}", plan.task, s.action, s.segment + 1);
+        let svg = super::swivel_map_svg(&entry.map, &title)
+            .map_err(|message| PlotError::Draw { kind: "swivel map", message })?;
+        let slowed = if s.slowed_down > 1.0 {
+            format!(
+                " The plan slowed this segment by ×{} to keep the joint limits.",
+                fixed(s.slowed_down, 3)
+            )
+        } else {
+            String::new()
+        };
+        let free = 100.0
+            - 100.0 * entry.map.runs.iter().map(|r| Real::from(r.count)).sum::<Real>()
+                / (entry.map.times.len() * entry.map.angle_steps).max(1) as Real;
+        let _ = write!(
+            out,
+            "<figure class=\"map\" data-segment=\"{}\"><figcaption>{} — {} × {} cells, {} % free, \
+             plan time {} s to {} s.{slowed}</figcaption><div class=\"figure\">{}</div></figure>\n",
+            entry.segment,
+            escape(&title),
+            entry.map.times.len(),
+            entry.map.angle_steps,
+            fixed(free, 1),
+            fixed(s.start, 3),
+            fixed(s.end, 3),
+            responsive(&svg),
+        );
+    }
+    out.push_str("</section>\n");
+    Ok(())
 }
 
 /// The plot page with a time mark (a vertical line) in each timed chart, placed by the script.
@@ -549,6 +597,7 @@ td.n { text-align: right; font-variant-numeric: tabular-nums; }
 pre { background: var(--card); padding: 10px; overflow-x: auto; font-size: 0.8rem;
   border-radius: 6px; }
 .figure { background: #ffffff; border-radius: 6px; padding: 4px; }
+.map { margin: 0 0 14px; } .map figcaption { color: var(--muted); font-size: 0.85rem; }
 svg.plot { width: 100%; height: auto; display: block; }
 .now { stroke: #6b7280; stroke-width: 1.5; stroke-dasharray: 4 3; }
 .views { display: grid; grid-template-columns: repeat(auto-fit, minmax(280px, 1fr)); gap: 12px; }

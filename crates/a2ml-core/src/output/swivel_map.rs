@@ -1,10 +1,11 @@
 //! The time × swivel map as an SVG figure, drawn as the paper's are (time horizontal, swivel
-//! vertical, one colour per obstacle's forbidden region, the profile as a line).
+//! vertical, one colour per obstacle's forbidden region, the profile as a line), from the
+//! [`MapSummary`] a plan keeps: `a2ml map` and the report draw the same figure.
 
 use plotters::prelude::*;
 
 use crate::math::{PI, Real};
-use crate::solve::map::{Cell, SwivelMap, SwivelProfile};
+use crate::solve::map::{Cell, MapSummary};
 
 /// Pixel size of the figure.
 const SIZE: (u32, u32) = (900, 560);
@@ -36,29 +37,21 @@ fn wrapped_degrees(a: Real) -> Real {
     ((a + PI).rem_euclid(2.0 * PI) - PI).to_degrees()
 }
 
-/// The figure of `map` with `profile` (if any), titled `title`, as an SVG document.
+/// The figure of a map and its profile (if it has one), titled `title`, as an SVG document.
+/// Time is the segment's own, from its start (s), as the map solver solved it.
 ///
 /// # Errors
 /// A message when plotters fails to lay the figure out.
-pub fn swivel_map_svg(
-    map: &SwivelMap,
-    profile: Option<&SwivelProfile>,
-    title: &str,
-) -> Result<String, String> {
+pub fn swivel_map_svg(map: &MapSummary, title: &str) -> Result<String, String> {
     let mut svg = String::new();
-    draw(&mut svg, map, profile, title).map_err(|e| e.to_string())?;
+    draw(&mut svg, map, title).map_err(|e| e.to_string())?;
     Ok(svg)
 }
 
-fn draw(
-    svg: &mut String,
-    map: &SwivelMap,
-    profile: Option<&SwivelProfile>,
-    title: &str,
-) -> Result<(), Box<dyn std::error::Error>> {
+fn draw(svg: &mut String, map: &MapSummary, title: &str) -> Result<(), Box<dyn std::error::Error>> {
     let root = SVGBackend::with_string(svg, SIZE).into_drawing_area();
     root.fill(&WHITE)?;
-    let duration = map.times.last().copied().unwrap_or(1.0).max(1e-9);
+    let duration = map.duration().max(1e-9);
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 18))
         .margin(12)
@@ -72,7 +65,7 @@ fn draw(
         .y_desc("swivel angle θsw (deg)")
         .y_labels(9)
         .draw()?;
-    // Each column's cell spans half a time step either side; runs of one label are one box.
+    // Each column's cell spans half a time step either side; a run of one label is one box.
     let nt = map.times.len();
     let half = |i: usize| {
         let before = if i > 0 { map.times[i - 1] } else { map.times[i] };
@@ -80,56 +73,51 @@ fn draw(
         (0.5 * (before + map.times[i]), 0.5 * (map.times[i] + after))
     };
     let step = map.angle_step().to_degrees();
-    let mut boxes = Vec::new();
-    for i in 0..nt {
-        let (t0, t1) = half(i);
-        if map.faults[i].is_some() {
-            boxes.push(Rectangle::new([(t0, -180.0), (t1, 180.0)], FAULT.filled()));
+    let faulty: Vec<usize> = map.faults.iter().map(|(i, _)| *i).filter(|i| *i < nt).collect();
+    let mut boxes: Vec<Rectangle<(Real, Real)>> = faulty
+        .iter()
+        .map(|&i| {
+            let (t0, t1) = half(i);
+            Rectangle::new([(t0, -180.0), (t1, 180.0)], FAULT.filled())
+        })
+        .collect();
+    for run in map.runs.iter().filter(|r| (r.column as usize) < nt) {
+        let i = run.column as usize;
+        if faulty.contains(&i) {
             continue;
         }
-        let n = map.angles.len();
-        let mut j = 0;
-        while j < n {
-            let cell = map.cell(i, j);
-            let mut k = j + 1;
-            while k < n && map.cell(i, k) == cell {
-                k += 1;
-            }
-            if let Some(c) = colour(cell) {
-                let (a0, a1) = (-180.0 + j as Real * step, -180.0 + k as Real * step);
-                boxes.push(Rectangle::new([(t0, a0), (t1, a1)], c.filled()));
-            }
-            j = k;
+        if let Some(c) = colour(run.cell) {
+            let (t0, t1) = half(i);
+            let a0 = -180.0 + Real::from(run.first) * step;
+            let a1 = -180.0 + Real::from(run.first + run.count) * step;
+            boxes.push(Rectangle::new([(t0, a0), (t1, a1)], c.filled()));
         }
     }
     chart.draw_series(boxes)?;
     // The legend: one entry per obstacle that forbids something, then limits and self.
+    let labelled = |cell: Cell| map.runs.iter().any(|r| r.cell == cell);
     for (k, name) in map.obstacles.iter().enumerate() {
-        if map.cells.contains(&Cell::Obstacle(k as u16)) {
+        if labelled(Cell::Obstacle(k as u16)) {
             let c = OBSTACLE_COLOURS[k % OBSTACLE_COLOURS.len()];
             legend_entry(&mut chart, name, c)?;
         }
     }
-    if map.cells.contains(&Cell::Limits) {
+    if labelled(Cell::Limits) {
         legend_entry(&mut chart, "joint limits", LIMITS)?;
     }
-    if map.cells.contains(&Cell::SelfCollision) {
+    if labelled(Cell::SelfCollision) {
         legend_entry(&mut chart, "self-collision", SELF_COLLISION)?;
     }
-    if map.faults.iter().any(Option::is_some) {
+    if !faulty.is_empty() {
         legend_entry(&mut chart, "path infeasible", FAULT)?;
     }
-    if let Some(profile) = profile {
+    if let (Some(&(t_start, start)), Some(&(t_end, end))) =
+        (map.profile.first(), map.profile.last())
+    {
         // The profile, broken where it wraps through ±180°.
-        let points: Vec<(Real, Real)> = profile
-            .trajectory
-            .times()
-            .iter()
-            .zip(&profile.swivel)
-            .map(|(&t, &a)| (t, wrapped_degrees(a)))
-            .collect();
         let mut pieces: Vec<Vec<(Real, Real)>> = vec![Vec::new()];
-        for p in points {
+        for &(t, a) in &map.profile {
+            let p = (t, wrapped_degrees(a));
             let jumped = pieces
                 .last()
                 .and_then(|piece| piece.last())
@@ -149,18 +137,14 @@ fn draw(
                 });
             }
         }
-        let ends = [profile.swivel.first(), profile.swivel.last()];
-        if let [Some(&start), Some(&end)] = ends {
-            chart
-                .draw_series([Circle::new((0.0, wrapped_degrees(start)), 6, BLACK.filled())])?
-                .label("start")
-                .legend(|(x, y)| Circle::new((x + 8, y), 5, BLACK.filled()));
-            let end_point = (duration, wrapped_degrees(end));
-            chart
-                .draw_series([TriangleMarker::new(end_point, 7, BLACK.filled())])?
-                .label("end")
-                .legend(|(x, y)| TriangleMarker::new((x + 8, y), 6, BLACK.filled()));
-        }
+        chart
+            .draw_series([Circle::new((t_start, wrapped_degrees(start)), 6, BLACK.filled())])?
+            .label("start")
+            .legend(|(x, y)| Circle::new((x + 8, y), 5, BLACK.filled()));
+        chart
+            .draw_series([TriangleMarker::new((t_end, wrapped_degrees(end)), 7, BLACK.filled())])?
+            .label("end")
+            .legend(|(x, y)| TriangleMarker::new((x + 8, y), 6, BLACK.filled()));
     }
     chart
         .configure_series_labels()

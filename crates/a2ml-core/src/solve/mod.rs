@@ -36,6 +36,6 @@ pub use checks::CheckError;
 pub use monitor::Monitor;
 pub use plan::{PlanOptions, Progress, SolveError, plan, plan_with_progress};
 pub use report::{
-    Fallback, Plan, QpStats, ReferenceSample, ReferenceState, SegmentReport, Tolerance,
-    VariableError, Warning, WarningKind,
+    Fallback, Plan, QpStats, ReferenceSample, ReferenceState, SegmentReport, SegmentSwivelMap,
+    Tolerance, VariableError, Warning, WarningKind,
 };

@@ -17,13 +17,14 @@ use super::constrained_rrt::constrained_rrt_monitored;
 use super::control::{BaselineOptions, ControlError, ControlOptions, ControlRun};
 use super::hamp::{HampOptions, HandoverTarget, plan_handover};
 use super::judge::{self, Judgement};
-use super::map::{MapError, MapOptions, map_segment};
+use super::map::{MapError, MapOptions, MapSummary, map_segment};
 use super::monitor::{Monitor, deadline_after};
 use super::problem::{Component, SegmentProblem};
 use super::qp::{self, QpError, QpOptions};
 use super::references::{Placed, reference_ends, reference_samples};
 use super::report::{
-    Fallback, Plan, QpStats, SegmentReport, Tolerance, VariableError, Warning, WarningKind,
+    Fallback, Plan, QpStats, SegmentReport, SegmentSwivelMap, Tolerance, VariableError, Warning,
+    WarningKind,
 };
 use super::rrt::{RrtError, RrtOptions, RrtStats, rrt_connect_monitored};
 use super::timing::{TimedPath, time_constrained, time_parameterise};
@@ -333,8 +334,12 @@ pub fn plan_with_progress(
     let reference_ends = reference_ends(robot, &placed);
     let mut segments = Vec::with_capacity(state.pieces.len());
     let mut wrist_reference = Vec::new();
+    let mut swivel_maps = Vec::new();
     for piece in state.pieces {
         wrist_reference.extend(piece.reference.iter().map(|(t, p)| (piece.start + t, *p)));
+        if let Some(map) = piece.swivel_map {
+            swivel_maps.push(SegmentSwivelMap { segment: segments.len(), map });
+        }
         segments.push(piece.report);
     }
     let distances = capsule_distances(&whole, robot, &task_b.scene, |sample, obstacle| {
@@ -360,6 +365,7 @@ pub fn plan_with_progress(
         references,
         reference_ends,
         distances,
+        swivel_maps,
     })
 }
 
@@ -383,6 +389,8 @@ struct Piece {
     stretch: Real,
     /// Start in the plan's time (s), once joined.
     start: Real,
+    /// The map and profile, when the swivel map solved the segment.
+    swivel_map: Option<MapSummary>,
 }
 
 impl Piece {
@@ -500,6 +508,7 @@ impl Solver<'_> {
                 problem: job.problem,
                 stretch: 1.0,
                 start: 0.0,
+                swivel_map: solution.swivel_map,
             });
             let done = self.pieces.len();
             progress(&Progress {
@@ -778,6 +787,7 @@ impl Solver<'_> {
             qp: solution.stats,
             rrt: None,
             fallback: None,
+            swivel_map: None,
         })
     }
 
@@ -822,13 +832,15 @@ impl Solver<'_> {
             safety_distance: self.options.safety_distance,
             ..self.options.map.clone()
         };
-        let (_, profile) = map_segment(self.robot, &obstacles, &job.problem, &self.q, &options)
+        let (map, profile) = map_segment(self.robot, &obstacles, &job.problem, &self.q, &options)
             .map_err(|source| SolveError::Map {
-                action: job.action.name.clone(),
-                segment: job.k,
-                source,
-            })?;
-        Ok(self.judged(job, SolverChoice::Map, profile.trajectory, 0.0, false, None))
+            action: job.action.name.clone(),
+            segment: job.k,
+            source,
+        })?;
+        let summary = MapSummary::new(&map, Some(&profile));
+        let solved = self.judged(job, SolverChoice::Map, profile.trajectory, 0.0, false, None);
+        Ok(Solved { swivel_map: Some(summary), ..solved })
     }
 
     /// A segment by one of the baselines, judged like every other solver: the segment's own
@@ -931,6 +943,7 @@ impl Solver<'_> {
             qp: QpStats::default(),
             rrt,
             fallback: None,
+            swivel_map: None,
         }
     }
 
@@ -1137,6 +1150,8 @@ struct Solved {
     rrt: Option<RrtStats>,
     /// Why `auto` went on from the QP to this solver.
     fallback: Option<Fallback>,
+    /// The map and profile, when the swivel map solved it.
+    swivel_map: Option<MapSummary>,
 }
 
 /// The trajectory with `offset` added to its times.

@@ -5,6 +5,7 @@ use crate::decompose::{ActionType, SegmentPattern};
 use crate::language::{SolverChoice, Space, Variable};
 use crate::math::{Real, UnitQuaternion, Vector3};
 use crate::spelling::spelled;
+use crate::solve::map::MapSummary;
 use crate::trajectory::{CapsuleDistances, Clearance, Trajectory};
 
 /// How close a goal must be reached.
@@ -198,6 +199,19 @@ pub struct Plan {
     pub reference_ends: Vec<ReferenceState>,
     /// The distance of every moving arm capsule to every obstacle at each sample.
     pub distances: Vec<CapsuleDistances>,
+    /// The map and profile of every segment the swivel map solved, in segment order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub swivel_maps: Vec<SegmentSwivelMap>,
+}
+
+/// The swivel map a segment of the plan was solved on.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SegmentSwivelMap {
+    /// Index in [`Plan::segments`].
+    pub segment: usize,
+    /// The map's cells and the profile chosen through them.
+    #[serde(flatten)]
+    pub map: MapSummary,
 }
 
 impl Plan {

@@ -2,7 +2,7 @@
 //! (docs/design.md §4, §5) and the checks run on the whole result: joint limits and clearance.
 //!
 //! Entry points: [`Trajectory::new`], [`join_sequential`], [`join_transitional`],
-//! [`check_limits`], [`peaks`], [`min_clearance`], [`capsule_distances`] (per sample),
+//! [`check_limits`], [`peaks`], [`min_clearance`], [`distance_pass`] (per sample, both),
 //! [`sample_times`] (the output grid),
 //! [`Trajectory::stretched`]. Between samples q follows the cubic Hermite curve through the
 //! samples' q and q', so the two stay consistent and the limits are checked at every instant
@@ -19,7 +19,7 @@ mod limits;
 #[cfg(test)]
 mod tests;
 
-pub use distances::{CapsuleDistances, capsule_distances};
+pub use distances::{CapsuleDistances, DistancePass, capsule_distances, distance_pass};
 pub use limits::{Limits, Peaks, peaks};
 
 /// Largest |q2(0) - q1(T1)| per joint accepted by [`join_sequential`] (rad).
@@ -405,7 +405,9 @@ pub struct Clearance {
 }
 
 /// The smallest [`collision::min_distance`] over the trajectory's samples, with when and
-/// between what it occurs; `None` when there is no pair to measure.
+/// between what it occurs; `None` when there is no pair to measure. The same as
+/// [`distance_pass`]'s clearance, without the per-capsule series: the bounding-sphere phase
+/// skips every pair that cannot beat the closest so far.
 pub fn min_clearance(
     trajectory: &Trajectory,
     robot: &Robot,

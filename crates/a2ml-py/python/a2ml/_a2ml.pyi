@@ -759,12 +759,15 @@ class Plan:
             ValueError: an unknown kind.
         """
 
-    def plot(self, path: str | os.PathLike[str], kind: Literal["joints", "velocities", "featured", "distances", "wrist", "all"] = "all") -> None:
-        """Write :meth:`to_svg` of ``kind`` to an SVG file. Atomic as
+    def plot(self, path: str | os.PathLike[str], kind: Literal["joints", "velocities", "featured", "distances", "wrist", "all"] = "all", width: int | None = None) -> None:
+        """Write :meth:`to_svg` of ``kind`` to an SVG file, or for a path
+        ending in ``.png`` a PNG image rendered from it (its text in the font
+        the library embeds: no system font is read), ``width`` pixels wide
+        (as drawn when None; the height in proportion). Atomic as
         :meth:`write_mcap`; releases the GIL.
 
         Raises:
-            ValueError: an unknown kind.
+            ValueError: an unknown kind, or a width outside 1 to 16384.
             OSError: the file cannot be written.
         """
 

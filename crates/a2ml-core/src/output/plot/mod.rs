@@ -6,13 +6,16 @@
 //! [`PlotData`] is what the drawing reads, taken out of the plan once. plotters enters the
 //! crate here only, with its SVG backend: text stays SVG `<text>`, so no font is loaded.
 //! Times are the plan's seconds, angles are drawn in degrees, distances in m or mm as the
-//! axes say; every joint keeps its Okabe–Ito colour across the plots.
+//! axes say; every joint keeps its Okabe–Ito colour across the plots. A picture is written as
+//! SVG or, by the file's extension, as PNG ([`png`]: resvg with an embedded font).
 
 mod data;
 mod draw;
+mod png;
 
 pub use data::{DistanceSeries, FeaturedPanel, PlotData, Runs, SegmentMark};
 pub use draw::{PALETTE, outline};
+pub use png::{MAX_WIDTH, png, scaled_size};
 
 use std::path::Path;
 
@@ -117,6 +120,72 @@ pub enum PlotError {
         /// The backend's message.
         message: String,
     },
+    /// The width asked for is out of range.
+    #[error("a picture is 1 to {max} pixels wide, not {width}")]
+    Size {
+        /// The width asked for (px).
+        width: u32,
+        /// The widest picture drawn (px).
+        max: u32,
+    },
+}
+
+/// The file format of a picture.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// An SVG document (text, scalable).
+    Svg,
+    /// A PNG image (pixels), rendered from the SVG.
+    Png,
+}
+
+impl ImageFormat {
+    /// The format a file name asks for: PNG for `.png` (any case), else SVG.
+    pub fn of_path(path: &Path) -> Self {
+        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
+            Self::Png
+        } else {
+            Self::Svg
+        }
+    }
+}
+
+/// The picture's SVG document `width` pixels wide (as drawn when `None`), its height in
+/// proportion; the drawing scales with it through the document's `viewBox`.
+///
+/// # Errors
+/// [`PlotError::Size`] as [`scaled_size`].
+pub fn svg_sized(picture: &Picture, width: Option<u32>) -> Result<String, PlotError> {
+    let (w, h) = scaled_size(picture, width)?;
+    if (w, h) == picture.size {
+        return Ok(picture.svg.clone());
+    }
+    let (own_w, own_h) = picture.size;
+    let root = format!("<svg width=\"{own_w}\" height=\"{own_h}\"");
+    match picture.svg.strip_prefix(&root) {
+        Some(rest) if picture.svg[..picture.svg.find('>').unwrap_or(0)].contains("viewBox") => {
+            Ok(format!("<svg width=\"{w}\" height=\"{h}\"{rest}"))
+        }
+        _ => Err(PlotError::Draw {
+            kind: "svg",
+            message: "the document has no sized root with a viewBox to scale".to_owned(),
+        }),
+    }
+}
+
+/// The picture as the bytes of a file of `format`, `width` pixels wide (as drawn when `None`).
+///
+/// # Errors
+/// As [`svg_sized`] and [`png`].
+pub fn encode(
+    picture: &Picture,
+    format: ImageFormat,
+    width: Option<u32>,
+) -> Result<Vec<u8>, PlotError> {
+    match format {
+        ImageFormat::Svg => svg_sized(picture, width).map(String::into_bytes),
+        ImageFormat::Png => png(picture, width),
+    }
 }
 
 /// Draws `kind` of `plan` (made from `task` on `robot`) as an SVG picture.
@@ -140,29 +209,39 @@ pub fn plot_data_svg(data: &PlotData, kind: PlotKind) -> Result<Picture, PlotErr
     draw::picture(data, kind)
 }
 
-/// Writes `kind` of the plot data as an SVG file, through a temporary file renamed into place.
+/// Writes `kind` of the plot data as an SVG or PNG file (by `path`'s extension, see
+/// [`ImageFormat::of_path`]) `width` pixels wide (as drawn when `None`), through a temporary
+/// file renamed into place.
 ///
 /// # Errors
 /// As [`write_plot`].
-pub fn write_plot_data(path: &Path, data: &PlotData, kind: PlotKind) -> Result<(), OutputError> {
-    let picture = plot_data_svg(data, kind).map_err(|e| OutputError::Plot {
+pub fn write_plot_data(
+    path: &Path,
+    data: &PlotData,
+    kind: PlotKind,
+    width: Option<u32>,
+) -> Result<(), OutputError> {
+    let failed = |e: PlotError| OutputError::Plot {
         path: path.display().to_string(),
         message: e.to_string(),
-    })?;
-    super::write_text(path, &picture.svg)
+    };
+    let picture = plot_data_svg(data, kind).map_err(failed)?;
+    let bytes = encode(&picture, ImageFormat::of_path(path), width).map_err(failed)?;
+    super::write_bytes(path, &bytes)
 }
 
-/// Writes `kind` of `plan` as an SVG file, through a temporary file renamed into place.
+/// Writes `kind` of `plan` as an SVG or PNG file, as [`write_plot_data`].
 ///
 /// # Errors
-/// [`OutputError::Plot`] when the picture cannot be drawn, [`OutputError::Io`] when the file
-/// cannot be written; the target is then left untouched.
+/// [`OutputError::Plot`] when the picture cannot be drawn or the width is out of range,
+/// [`OutputError::Io`] when the file cannot be written; the target is then left untouched.
 pub fn write_plot(
     path: &Path,
     robot: &Robot,
     task: &Task,
     plan: &Plan,
     kind: PlotKind,
+    width: Option<u32>,
 ) -> Result<(), OutputError> {
-    write_plot_data(path, &PlotData::new(robot, task, plan), kind)
+    write_plot_data(path, &PlotData::new(robot, task, plan), kind, width)
 }

@@ -10,7 +10,7 @@ use crate::math::{JointVector, PI, Real, Vector3, wrap_angle};
 use crate::robot::{LinkRole, Robot};
 
 /// What a cell's configuration does.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Cell {
     /// Within limits and clear of everything.

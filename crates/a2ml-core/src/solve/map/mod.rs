@@ -4,18 +4,21 @@
 //! smoothest swivel profile through the free cells gives the joints by analytic IK.
 //!
 //! Entry points: [`build_map`] (the grid), [`plan_profile`] (the profile and its joints),
-//! [`segment_map`] (both for one segment of a task). Angles are periodic on [−π, π); cell j
-//! of N covers [−π + jΔθ, −π + (j+1)Δθ) and is labelled at its centre.
+//! [`segment_map`] (both for one segment of a task), [`MapSummary`] (both as a plan keeps
+//! them). Angles are periodic on [−π, π); cell j of N covers [−π + jΔθ, −π + (j+1)Δθ) and is
+//! labelled at its centre.
 
 mod grid;
 mod profile;
 pub mod sphere;
 pub mod spline;
+mod summary;
 mod task;
 
 pub use grid::{Cell, ColumnFault, ForbiddenInterval, SwivelMap, build_map};
 pub use profile::{SwivelProfile, plan_profile};
 pub use spline::{ClampedSpline, SplineError, chord_length_times};
+pub use summary::{CellRun, MapSummary};
 pub use task::{SegmentMap, SegmentMapError, map_segment, segment_map};
 
 use crate::kinematics::KinematicsError;
