@@ -238,7 +238,7 @@ def test_unavailable_solver_raises() -> None:
 
 
 def test_unknown_solver_raises() -> None:
-    with pytest.raises(ValueError, match="unknown solver 'fast'"):
+    with pytest.raises(ValueError, match=r"unknown solver `fast` \(expected one of: auto, qp, rrt, "):
         a2ml.plan(EXAMPLE, solver="fast")  # type: ignore[arg-type]
 
 

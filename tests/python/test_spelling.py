@@ -143,3 +143,13 @@ def test_decomposition_task_and_compare_use_the_same_spellings() -> None:
     records = a2ml.compare(EXAMPLES / "construct_path_line.a2ml", solvers=["qp"])
     keys = {k for r in records for k in r if k.startswith("error_")}
     assert keys and keys <= {f"error_{v}" for v in DOCS["variable"]}
+
+
+def test_a_corrupt_pickle_state_raises_value_error(plans: Dict[str, Plan]) -> None:
+    plan = plans["construct_path_line"]
+    rebuild, (robot, task, text, timings) = plan.__reduce__()
+    assert rebuild(robot, task, text, timings).segments == plan.segments
+    with pytest.raises(ValueError, match="invalid plan: unknown variant `CPSA`"):
+        rebuild(robot, task, text.replace('"cpsa"', '"CPSA"'), timings)
+    with pytest.raises(ValueError, match="timings for"):
+        rebuild(robot, task, text, timings[:-1])

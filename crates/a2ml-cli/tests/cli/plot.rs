@@ -133,7 +133,9 @@ fn the_report_table_says_what_plan_json_says() {
             let number = |key: &str| s[key].as_f64().expect("a number");
             assert_eq!(row[0].0, s["action"].as_str().expect("action"), "{name}");
             assert_eq!(row[1].0, (s["segment"].as_u64().expect("index") + 1).to_string());
-            assert_eq!(row[4].0, s["space"].as_str().expect("space").to_uppercase());
+            assert_eq!(row[2].0, s["action_type"].as_str().unwrap_or("-"), "{name}: type");
+            assert_eq!(row[3].0, s["pattern"].as_str().expect("pattern"), "{name}: pattern");
+            assert_eq!(row[4].0, s["space"].as_str().expect("space"), "{name}: space");
             assert_eq!(row[5].0, s["solver"].as_str().expect("solver"));
             assert_eq!(row[6].1, Some(number("start")), "{name}: start");
             assert_eq!(row[7].1, Some(number("end")), "{name}: end");
@@ -159,7 +161,11 @@ fn the_report_table_says_what_plan_json_says() {
         let warnings = plan["warnings"].as_array().expect("warnings");
         let page = fs::read_to_string(&html).expect("html");
         for w in warnings {
-            let text = w.as_str().expect("a warning").replace('&', "&amp;").replace('<', "&lt;");
+            let text = w["message"]
+                .as_str()
+                .expect("a warning")
+                .replace('&', "&amp;")
+                .replace('<', "&lt;");
             let text = text.replace('>', "&gt;").replace('"', "&quot;").replace('\'', "&#39;");
             assert!(page.contains(&format!("<li>{text}</li>")), "{name}: warning {text}");
         }

@@ -424,7 +424,9 @@ mod tests {
     fn numbers_and_numerals() {
         let numbers: Vec<u8> = ActionType::ALL.iter().map(|t| t.number()).collect();
         assert_eq!(numbers, [1, 2, 3, 4, 5, 6, 7]);
-        assert_eq!(ActionType::VII.to_string(), "VII");
+        // The value is spelled in lower case; prose writes the paper's numeral.
+        assert_eq!(ActionType::VII.to_string(), "vii");
+        assert_eq!(ActionType::VII.numeral(), "VII");
     }
 
     #[test]

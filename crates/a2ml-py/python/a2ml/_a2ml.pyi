@@ -9,8 +9,8 @@ infinite entry raises ``ValueError``. Rotation matrices must be orthonormal to
 1e-6 with determinant +1, else ``ValueError``.
 
 A task (:func:`parse`, :func:`load`) comes back as plain Python data in SI
-units: state variables are spelled as :class:`Robot` names them (``"pw"``,
-``"ow"``, ``"swivel"``, ``"os"``, ``"elbow"``), positions are arrays of shape
+units: state variables are spelled once, as every output spells them (``"pw"``,
+``"ow"``, ``"swivel"``, ``"shoulder_frame"``, ``"elbow"``), positions are arrays of shape
 (3,), rotations (3, 3), angles floats. :func:`decompose` turns a task into
 movement segments, returned in the same spelling (keys as in
 :class:`a2ml.Decomposition`). :func:`plan` solves them into a :class:`Plan`:
@@ -387,11 +387,11 @@ class Task:
         pw: ArrayLike | None = ...,
         ow: ArrayLike | None = ...,
         swivel: float | None = ...,
-        os: ArrayLike | None = ...,
+        shoulder_frame: ArrayLike | None = ...,
         elbow: float | None = ...,
     ) -> Task:
         """A new task: this one with the goal values of ``action`` replaced
-        (``pw``: a (3,) position in m; ``ow``, ``os``: (3, 3) rotations;
+        (``pw``: a (3,) position in m; ``ow``, ``shoulder_frame``: (3, 3) rotations;
         ``swivel``, ``elbow``: angles in rad), in the task's frame. Only a
         goal the action states can change, in its primary or secondary term.
         The new task is this task's text with those values, printed in
@@ -438,13 +438,13 @@ def decompose(task: Task, robot: Robot | None = None) -> Decomposition:
 
     Returns a dict (shape :class:`a2ml.Decomposition`): ``"task"`` (name),
     ``"start"`` (joints, (7,)) and ``"actions"``, each with ``"index"`` (in
-    :attr:`Task.actions`), ``"name"``, ``"type"`` (``"I"`` ... ``"VII"``),
+    :attr:`Task.actions`), ``"name"``, ``"type"`` (``"i"`` ... ``"vii"``),
     ``"type_number"`` (1-7), ``"description"`` (of the type),
     ``"goal_space"``, ``"secondary_goal_space"``, ``"path_space"``
     (``"cpsa"``, ``"hat"`` or None; the classification is all None for an
     explicit action), ``"segments"`` and ``"optimisations"`` (``{"solver":
     "Opt1" | "Opt2", "residual", "sizes", "evaluations"}``). A segment is
-    ``{"space", "pattern" (1, 2 or 3), "duration" (s), "duration_raised",
+    ``{"space", "pattern" ("path", "goal" or "mixed"), "duration" (s), "duration_raised",
     "solver", "relaxed" ([variable]), "start", "end" ((7,) joints),
     "primitives"}`` with primitives as in an explicit segment of
     :attr:`Task.actions`.

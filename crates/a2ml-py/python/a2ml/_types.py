@@ -31,20 +31,6 @@ __all__ = [
 
 # A space is ``"cpsa"`` (Pw, Ow, swivel) or ``"hat"`` (Os, elbow, Ow); spelled
 # out below rather than as an alias, which stubtest cannot compare.
-_WarningKind = Literal[
-    "close_start",
-    "collision_geometry",
-    "rrt_failed",
-    "rrt_no_better",
-    "hamp_over_speed",
-    "rrt_slowed",
-    "slowed_down",
-    "blend_shortened",
-    "too_close",
-    "missed_goal",
-    "left_path",
-    "over_limits",
-]
 
 
 class OptReport(TypedDict):
@@ -174,7 +160,20 @@ class PlanWarning(NamedTuple):
     ``action`` and ``segment`` (0-based, as :attr:`a2ml.SegmentReport.segment`)
     it names, if any, and the ``message`` the CLI prints (also ``str()``)."""
 
-    kind: _WarningKind
+    kind: Literal[
+        "close_start",
+        "collision_geometry",
+        "rrt_failed",
+        "rrt_no_better",
+        "hamp_over_speed",
+        "rrt_slowed",
+        "slowed_down",
+        "blend_shortened",
+        "too_close",
+        "missed_goal",
+        "left_path",
+        "over_limits",
+    ]
     action: Optional[str]
     segment: Optional[int]
     message: str
