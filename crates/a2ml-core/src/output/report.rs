@@ -333,7 +333,7 @@ fn swivel_maps(out: &mut String, plan: &Plan) -> Result<(), PlotError> {
         };
         let free = 100.0
             - 100.0 * entry.map.runs.iter().map(|r| Real::from(r.count)).sum::<Real>()
-                / (entry.map.times.len() * entry.map.angle_steps).max(1) as Real;
+                / entry.map.times.len().saturating_mul(entry.map.angle_steps).max(1) as Real;
         let _ = write!(
             out,
             "<figure class=\"map\" data-segment=\"{}\"><figcaption>{} — {} × {} cells, {} % free, \
