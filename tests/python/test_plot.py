@@ -41,6 +41,38 @@ def test_plot_writes_what_to_svg_returns(plan: Plan, tmp_path: Path) -> None:
     assert path.read_text(encoding="utf-8") == plan.to_svg("joints")
 
 
+def png_size(path: Path) -> tuple[int, int]:
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    assert data[12:16] == b"IHDR"
+    return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+
+
+def test_plot_to_a_png_path_writes_a_png_image(plan: Plan, tmp_path: Path) -> None:
+    root = ET.fromstring(plan.to_svg("joints"))
+    own = (int(root.attrib["width"]), int(root.attrib["height"]))
+    path = tmp_path / "joints.png"
+    plan.plot(path, kind="joints")
+    assert png_size(path) == own
+    plan.plot(path, kind="joints", width=400)
+    width, height = png_size(path)
+    assert width == 400 and abs(height - own[1] * 400 / own[0]) <= 1
+    for bad in (0, 100_000):
+        with pytest.raises(ValueError, match="width"):
+            plan.plot(tmp_path / "bad.png", width=bad)
+    assert not (tmp_path / "bad.png").exists()
+
+
+def test_a_pickled_plan_keeps_its_swivel_maps_for_the_report() -> None:
+    import pickle
+
+    mapped = a2ml.plan(TESTS_DIR / ".." / ".." / "examples" / "swivel_map_spheres.a2ml")
+    html = mapped.to_html()
+    assert '<section id="swivel-maps">' in html
+    again = pickle.loads(pickle.dumps(mapped))
+    assert again.to_html() == html
+
+
 def test_an_unknown_kind_is_a_value_error(plan: Plan, tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="wrist"):
         plan.to_svg("pie")  # type: ignore[arg-type]

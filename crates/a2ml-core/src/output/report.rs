@@ -333,11 +333,11 @@ fn swivel_maps(out: &mut String, plan: &Plan) -> Result<(), PlotError> {
         };
         let free = 100.0
             - 100.0 * entry.map.runs.iter().map(|r| Real::from(r.count)).sum::<Real>()
-                / (entry.map.times.len() * entry.map.angle_steps).max(1) as Real;
-        let _ = write!(
+                / entry.map.times.len().saturating_mul(entry.map.angle_steps).max(1) as Real;
+        let _ = writeln!(
             out,
             "<figure class=\"map\" data-segment=\"{}\"><figcaption>{} — {} × {} cells, {} % free, \
-             plan time {} s to {} s.{slowed}</figcaption><div class=\"figure\">{}</div></figure>\n",
+             plan time {} s to {} s.{slowed}</figcaption><div class=\"figure\">{}</div></figure>",
             entry.segment,
             escape(&title),
             entry.map.times.len(),
@@ -430,10 +430,10 @@ fn motion(out: &mut String, input: &ReportInput, data: &PlotData) {
     out.push_str(
         "</div>\n<div class=\"controls\"><button id=\"play\" type=\"button\">play</button>",
     );
-    let _ = write!(
+    let _ = writeln!(
         out,
         "<input id=\"time\" type=\"range\" min=\"0\" max=\"{count}\" value=\"0\" step=\"1\" \
-         aria-label=\"time\"><output id=\"clock\">{} s</output></div>\n",
+         aria-label=\"time\"><output id=\"clock\">{} s</output></div>",
         fixed(t0, 2)
     );
     // Frames: t, then x y z of both ends of every capsule, rounded to 0.1 mm.
@@ -564,10 +564,10 @@ fn view_svg(
     }
     let bar_y = y0 + 0.04 * (y1 - y0);
     let bar_x = x0 + 0.04 * (x1 - x0);
-    let _ = write!(
+    let _ = writeln!(
         out,
         "<line class=\"scale\" x1=\"{bar_x:.4}\" y1=\"{bar_y:.4}\" x2=\"{:.4}\" y2=\"{bar_y:.4}\" \
-         stroke-width=\"{:.4}\"/></g></svg></figure>\n",
+         stroke-width=\"{:.4}\"/></g></svg></figure>",
         bar_x + 0.1,
         width / 150.0
     );

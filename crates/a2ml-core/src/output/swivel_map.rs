@@ -89,7 +89,7 @@ fn draw(svg: &mut String, map: &MapSummary, title: &str) -> Result<(), Box<dyn s
         if let Some(c) = colour(run.cell) {
             let (t0, t1) = half(i);
             let a0 = -180.0 + Real::from(run.first) * step;
-            let a1 = -180.0 + Real::from(run.first + run.count) * step;
+            let a1 = -180.0 + Real::from(run.first.saturating_add(run.count)) * step;
             boxes.push(Rectangle::new([(t0, a0), (t1, a1)], c.filled()));
         }
     }

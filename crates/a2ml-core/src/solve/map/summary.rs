@@ -88,7 +88,7 @@ impl MapSummary {
         let (i, j) = (i as u32, j as u32);
         self.runs
             .iter()
-            .find(|r| r.column == i && (r.first..r.first + r.count).contains(&j))
+            .find(|r| r.column == i && (r.first..r.first.saturating_add(r.count)).contains(&j))
             .map_or(Cell::Free, |r| r.cell)
     }
 
