@@ -15,6 +15,7 @@ mod format;
 mod syntax;
 mod task;
 mod validate;
+mod variable;
 
 use std::path::Path;
 

@@ -287,7 +287,7 @@ impl Checker<'_> {
                 }
             },
             ValueKind::Rotation => {
-                let keys = if var == Variable::Os { ["r", "l"] } else { ["f", "p"] };
+                let keys = var.body_axes().map_or(["f", "p"], |axes| axes.map(BodyAxis::name));
                 self.rotation(value, keys, var.symbol()).map(Target::Rotation)
             }
             ValueKind::Angle => match value {

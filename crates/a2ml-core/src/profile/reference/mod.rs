@@ -175,7 +175,7 @@ impl Reference {
             (Target::Angle(a), Target::Angle(b)) => Reference::Angle(AngleReference::goal(
                 a,
                 b,
-                variable == Variable::Swivel,
+                variable.wraps(),
                 duration,
             )?),
             // check_kind made both kinds the variable's; kept total without a panic.
@@ -232,7 +232,7 @@ impl Reference {
             (PathFeature::By { angle }, Target::Angle(a)) => Reference::Angle(AngleReference::by(
                 a,
                 angle,
-                variable == Variable::Swivel,
+                variable.wraps(),
                 duration,
             )?),
             _ => return Err(ProfileError::FeatureMismatch { variable, feature: keyword }),
@@ -249,7 +249,7 @@ impl Reference {
             Target::Position(p) => Reference::Position(PositionReference::hold(p, duration)?),
             Target::Rotation(r) => Reference::Rotation(RotationReference::hold(r, duration)?),
             Target::Angle(a) => {
-                Reference::Angle(AngleReference::hold(a, variable == Variable::Swivel, duration)?)
+                Reference::Angle(AngleReference::hold(a, variable.wraps(), duration)?)
             }
         })
     }
@@ -335,7 +335,8 @@ mod tests {
     use super::*;
     use crate::math::{PI, rotation_about, rotation_distance};
 
-    fn rot(axis: Vector3, angle: Real) -> Rotation3 {
+    /// The rotation about `axis` (normalised here) by `angle`, for the kinds' tests too.
+    pub(super) fn rot(axis: Vector3, angle: Real) -> Rotation3 {
         Rotation3::from_matrix_unchecked(rotation_about(&axis.normalize(), angle))
     }
 

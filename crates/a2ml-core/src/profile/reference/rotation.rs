@@ -138,12 +138,9 @@ impl RotationReference {
 
 #[cfg(test)]
 mod tests {
+    use super::super::tests::rot;
     use super::*;
     use crate::math::rotation_distance;
-
-    fn rot(axis: Vector3, angle: Real) -> Rotation3 {
-        Rotation3::from_matrix_unchecked(rotation_about(&axis.normalize(), angle))
-    }
 
     #[test]
     fn geodesic_matches_the_exponential_form() {
