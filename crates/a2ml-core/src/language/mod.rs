@@ -10,6 +10,7 @@
 pub mod ast;
 mod bounds;
 mod diagnostic;
+pub mod display;
 mod edit;
 mod format;
 mod syntax;
