@@ -167,7 +167,7 @@ fn a_goal_reachable_only_by_ordering() {
 
 #[test]
 fn a_goal_no_ordering_reaches_is_reported() {
-    // Wiping now also knocks the cup off the table.
+    // Here wiping also knocks the cup off the table.
     let body =
         WIPE_AND_PLACE.replace("add { table_clean }", "add { table_clean } del { cup_on_table }");
     let err = order(&task(&file(&body))).expect_err("no ordering");

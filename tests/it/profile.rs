@@ -6,6 +6,7 @@ use a2ml::math::{
     JointVector, PI, Real, Rotation3, Vector3, rotation_distance, rotation_log, wrap_angle,
 };
 use a2ml::profile::*;
+use a2ml::trajectory::join::{self, SequentialOptions, Transition, TransitionOptions};
 use nalgebra::Unit;
 use rand::RngExt;
 use rand::rngs::StdRng;
@@ -344,7 +345,7 @@ fn transitional_blend_is_continuous_at_the_seams() {
         let transition =
             Transition::with_options(t1, t2, &TransitionOptions::default()).expect("valid");
         assert!((transition.overlap() - 0.2 * t1.min(t2)).abs() < 1e-15);
-        let joined = join_transitional(first.clone(), second.clone(), transition);
+        let joined = join::transitional(first.clone(), second.clone(), transition);
         let t2s = transition.second_start();
         let t1e = transition.first_end();
 
@@ -383,11 +384,11 @@ fn transitions_chain() {
     let durations = [1.0, 2.0, 1.5];
     let first = Transition::with_options(durations[0], durations[1], &TransitionOptions::default())
         .expect("valid");
-    let joined = join_transitional(segments[0].clone(), segments[1].clone(), first);
+    let joined = join::transitional(segments[0].clone(), segments[1].clone(), first);
     let second =
         Transition::with_options(first.duration(), durations[2], &TransitionOptions::default())
             .expect("valid");
-    let all = join_transitional(joined, segments[2].clone(), second);
+    let all = join::transitional(joined, segments[2].clone(), second);
     assert!((second.duration() - (1.0 + 2.0 + 1.5 - 0.2 - 0.3)).abs() < 1e-12);
     for seam in [first.second_start(), first.first_end(), second.second_start(), second.first_end()]
     {
@@ -409,14 +410,14 @@ fn sequential_join_starts_the_next_segment_at_rest_where_the_last_ended() {
     };
     let options = SequentialOptions::default();
     let joined =
-        join_sequential(motion(q0, q1, t1), t1, motion(q1, q2, t2), &options).expect("at rest");
+        join::sequential(motion(q0, q1, t1), t1, motion(q1, q2, t2), &options).expect("at rest");
     let (a, b) = (joined(t1 - 1e-12), joined(t1 + 1e-12));
     assert!((a.0 - b.0).amax() < 1e-9 && (a.1 - b.1).amax() < 1e-9);
     assert!((joined(t1 + t2).0 - q2).amax() < 1e-15);
 
     let elsewhere = motion(q0, q2, t2);
     assert!(matches!(
-        join_sequential(motion(q0, q1, t1), t1, elsewhere, &options),
+        join::sequential(motion(q0, q1, t1), t1, elsewhere, &options),
         Err(ProfileError::Discontinuous { .. })
     ));
 }

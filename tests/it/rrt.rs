@@ -139,7 +139,7 @@ fn an_end_just_beyond_the_clearance_is_planned_from_and_to() {
         .expect("the Panda has a hand capsule");
     let side = (hand.b - hand.a).cross(&Vector3::z()).normalize();
     // A ball beside the hand at the start, 1 mm and 0.1 mm beyond the clearance: less than the
-    // clearance plus the resolution, which every check used to ask for.
+    // clearance plus the resolution, so a check that asked for that margin would refuse it.
     for slack in [1e-3, 1e-4] {
         let (radius, gap) = (0.03, options.clearance + slack);
         let center = 0.5 * (hand.a + hand.b) + side * (hand.radius + gap + radius);

@@ -1,11 +1,16 @@
 //! a2ml: plans human-like motions for 7-DoF anthropomorphic arms from tasks
 //! written in A2ML (Fang & Ding 2019).
 //!
-//! The modules follow the pipeline: [`robot`] (URDF to an arm model),
-//! [`kinematics`] (FK, CPSA and HAT states, Jacobians, IK), [`language`]
-//! (task files to a validated [`language::Task`]), [`decompose`] (action
-//! order and types), [`profile`] (bell profiles, references, weights and
-//! the joining of segments), [`collision`] (arm capsules against the scene).
+//! The modules follow the pipeline, data flowing one way: [`robot`] (URDF to an
+//! arm model), [`kinematics`] (FK, CPSA and HAT states, Jacobians, IK, swivel
+//! intervals), [`language`] (task files to a validated [`language::Task`]),
+//! [`decompose`] (action order, types and segments), [`profile`] (bell profiles,
+//! references, weights), [`collision`] (arm capsules against the scene),
+//! [`solve`] (`plan`: each segment by the QP, an RRT, the swivel map or a
+//! baseline, joined and checked), [`trajectory`] (sampled joint trajectories,
+//! their joining and limit checks), [`metrics`] (human-likeness measures) and
+//! [`output`] (MCAP, CSV, JSON, Parquet, SVG and HTML). [`math`] fixes the scalar
+//! type and aliases, [`names`] suggests names, [`error`] wraps each module's error.
 
 pub mod collision;
 pub mod decompose;

@@ -14,8 +14,8 @@
 use std::path::PathBuf;
 
 use a2ml_core::language::{
-    self, Action, ActionBody, Axis, BodyAxis, Goal, GoalConstraint, Obstacle, PathConstraint,
-    PathFeature, PathItem, PositionFrame, Primitive, PrimitiveConstraint, Segment, Settings, Shape,
+    self, Action, ActionBody, Axis, Goal, GoalConstraint, Obstacle, PathConstraint, PathFeature,
+    PathItem, PositionFrame, Primitive, PrimitiveConstraint, Segment, Settings, Shape,
     SolverChoice, Space, Start, Target, Variable,
 };
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -320,12 +320,7 @@ fn axis<'py>(py: Python<'py>, a: &Axis) -> PyResult<Bound<'py, PyAny>> {
     Ok(match a {
         Axis::Base(direction) => to_vector(py, direction.as_slice()).into_any(),
         Axis::Body(body, sign) => {
-            let name = match body {
-                BodyAxis::R => "r",
-                BodyAxis::L => "l",
-                BodyAxis::F => "f",
-                BodyAxis::P => "p",
-            };
+            let name = body.name();
             let signed = if *sign < 0.0 { format!("-{name}") } else { name.to_owned() };
             PyString::new(py, &signed).into_any()
         }

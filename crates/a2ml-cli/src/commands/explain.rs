@@ -15,11 +15,12 @@ use a2ml_core::Robot;
 use a2ml_core::decompose::{
     self, DecomposeError, DecomposeOptions, Decomposition, OptReport, PlannedAction, PlannedSegment,
 };
+use a2ml_core::language::display::{number_list, path_size, rpy_degrees, short_number};
 use a2ml_core::language::{
-    self as language, ActionBody, Axis, BodyAxis, Goal, GoalConstraint, PathConstraint,
-    PathFeature, Primitive, PrimitiveConstraint, Space, Target, Task, Variable,
+    self as language, ActionBody, Goal, PathFeature, Primitive, PrimitiveConstraint, Space, Target,
+    Task, Variable,
 };
-use a2ml_core::math::{DOF, JointVector, Real, Rotation3, Vector3};
+use a2ml_core::math::{DOF, JointVector, Real};
 
 use crate::error::CliError;
 use crate::output::{self, COARSE, FINE, deg, num, quaternion, unsigned_zero, vec3};
@@ -313,18 +314,12 @@ fn symbols(variables: &[Variable]) -> Vec<&'static str> {
     variables.iter().map(|v| v.symbol()).collect()
 }
 
-/// Roll, pitch, yaw (deg) of R = Rz·Ry·Rx, as `rpy(..)` reads them.
-fn rpy_deg(r: &Rotation3) -> [Real; 3] {
-    let (roll, pitch, yaw) = r.euler_angles();
-    [roll, pitch, yaw].map(|a| unsigned_zero(deg(a)))
-}
-
 impl TargetReport {
     fn new(variable: Variable, target: &Target) -> Self {
         let blank = Self {
             variable: variable.symbol(),
             kind: "",
-            text: text::target(target),
+            text: target.to_string(),
             position: None,
             quaternion: None,
             rpy_deg: None,
@@ -336,7 +331,7 @@ impl TargetReport {
             Target::Rotation(r) => Self {
                 kind: "rotation",
                 quaternion: Some(quaternion(r)),
-                rpy_deg: Some(rpy_deg(r)),
+                rpy_deg: Some(rpy_degrees(r)),
                 ..blank
             },
             Target::Angle(a) => Self {
@@ -366,7 +361,7 @@ impl FeatureReport {
                 ("line", Some(vec3(direction)), None, (length.map(unsigned_zero), None))
             }
             PathFeature::About { axis, angle: a } => {
-                ("about", None, Some(text::axis(axis)), angle(*a))
+                ("about", None, Some(axis.to_string()), angle(*a))
             }
             PathFeature::By { angle: a } => ("by", None, None, angle(Some(*a))),
             PathFeature::Hold => ("hold", None, None, (None, None)),
@@ -388,13 +383,7 @@ impl PrimitiveReport {
             }
             PrimitiveConstraint::Hold => ("hold", Vec::new(), None),
         };
-        Self {
-            constraint,
-            variables: symbols(&p.variables),
-            text: text::primitive(p),
-            targets,
-            path,
-        }
+        Self { constraint, variables: symbols(&p.variables), text: p.to_string(), targets, path }
     }
 }
 
@@ -457,12 +446,12 @@ impl ActionReport {
             secondary_goal_space: c.and_then(|c| c.secondary_goal_space).map(Space::name),
             path_space: c.and_then(|c| c.path_space).map(Space::name),
             goal: goal.map(|g| GoalConstraintReport {
-                text: text::goal_constraint(g),
+                text: g.to_string(),
                 primary: GoalReport::new(&g.primary),
                 secondary: g.secondary.as_ref().map(GoalReport::new),
             }),
             path: path.map(|p| PathConstraintReport {
-                text: text::path_constraint(p),
+                text: p.to_string(),
                 hard: p.hard,
                 space: p.space.map(Space::name),
                 items: p
@@ -561,7 +550,7 @@ impl ActionReport {
             out.line(2, format!("PC    path {}{}{note}", p.text, spaces(self.path_space, None)));
         }
         if let Some(d) = self.duration {
-            out.line(2, format!("duration {} s (given for the action)", text::short(d, SECONDS)));
+            out.line(2, format!("duration {} s (given for the action)", short_number(d, SECONDS)));
         }
         for s in &self.segments {
             s.render(out);
@@ -579,14 +568,14 @@ impl ActionReport {
                                 "{} {} {}",
                                 i.variables.join(" "),
                                 i.feature.feature,
-                                text::size(i.feature.feature, *s)
+                                path_size(i.feature.feature, *s)
                             )
                         })
                         .collect();
                     format!(", sizes {}", items.join(", "))
                 }
                 _ if !o.sizes.is_empty() => {
-                    format!(", sizes {}", text::list(&o.sizes, FINE))
+                    format!(", sizes {}", number_list(&o.sizes, FINE))
                 }
                 _ => String::new(),
             };
@@ -623,7 +612,7 @@ impl SegmentReport {
                 self.number,
                 self.space,
                 self.pattern,
-                text::short(self.duration, SECONDS),
+                short_number(self.duration, SECONDS),
                 self.solver
             ),
         );
@@ -666,205 +655,18 @@ impl Tree {
     }
 }
 
-/// Values in A2ML syntax, with units: positions in m, angles in deg,
-/// rotations as `rpy(..) deg`, numbers without trailing zeros.
+/// The tree's own numbers; values are written by the core's `Display` impls
+/// ([`a2ml_core::language::display`]).
 mod text {
     use super::*;
 
-    /// `x` to at most `decimals` decimals, trailing zeros dropped.
-    pub fn short(x: Real, decimals: usize) -> String {
-        let text = num(x, decimals);
-        if text.contains('.') {
-            text.trim_end_matches('0').trim_end_matches('.').to_owned()
-        } else {
-            text
-        }
-    }
-
-    /// `[a, b, c]`.
-    pub fn list(values: &[Real], decimals: usize) -> String {
-        let items: Vec<String> = values.iter().map(|v| short(*v, decimals)).collect();
-        format!("[{}]", items.join(", "))
-    }
-
     /// Seven joint angles in degrees.
     pub fn joints_deg(q: &[Real]) -> String {
-        format!("{} deg", list(q, COARSE))
+        format!("{} deg", number_list(q, COARSE))
     }
 
     /// A residual: fixed decimals while readable, else scientific.
     pub fn residual(x: Real) -> String {
         if x == 0.0 || x >= 1e-4 { num(x, 6) } else { format!("{x:.2e}") }
-    }
-
-    /// A path size with its unit: m for `line`, deg otherwise.
-    pub fn size(feature: &str, s: Real) -> String {
-        if feature == "line" {
-            format!("{} m", short(s, FINE))
-        } else {
-            format!("{} deg", short(deg(s), COARSE))
-        }
-    }
-
-    /// One value.
-    pub fn target(t: &Target) -> String {
-        match t {
-            Target::Position(p) => format!("{} m", list(&vec3(p), FINE)),
-            Target::Rotation(r) => {
-                let [roll, pitch, yaw] = rpy_deg(r);
-                format!(
-                    "rpy({}, {}, {}) deg",
-                    short(roll, COARSE),
-                    short(pitch, COARSE),
-                    short(yaw, COARSE)
-                )
-            }
-            Target::Angle(a) => format!("{} deg", short(deg(*a), COARSE)),
-        }
-    }
-
-    /// An axis as written: `x`, `-z`, `r`, `-l`; another direction as a vector.
-    pub fn axis(axis: &Axis) -> String {
-        match axis {
-            Axis::Base(v) => {
-                let names = [(Vector3::x(), "x"), (Vector3::y(), "y"), (Vector3::z(), "z")];
-                names
-                    .iter()
-                    .find_map(|(unit, name)| {
-                        if (v - unit).norm() < 1e-12 {
-                            Some((*name).to_owned())
-                        } else if (v + unit).norm() < 1e-12 {
-                            Some(format!("-{name}"))
-                        } else {
-                            None
-                        }
-                    })
-                    .unwrap_or_else(|| list(&vec3(v), FINE))
-            }
-            Axis::Body(body, sign) => {
-                let name = match body {
-                    BodyAxis::R => "r",
-                    BodyAxis::L => "l",
-                    BodyAxis::F => "f",
-                    BodyAxis::P => "p",
-                };
-                if *sign < 0.0 { format!("-{name}") } else { name.to_owned() }
-            }
-        }
-    }
-
-    /// A feature with its size, if known; `in_call` puts a comma before the
-    /// size, as `a2ml fmt` writes it inside `.path(..)`.
-    pub fn feature(f: &PathFeature, in_call: bool) -> String {
-        let before = if in_call { ", " } else { " " };
-        let sized = |head: String, s: Option<Real>, kind: &str| match s {
-            Some(s) => format!("{head}{before}{}", size(kind, s)),
-            None => head,
-        };
-        match f {
-            PathFeature::Line { direction, length } => {
-                sized(format!("line {}", list(&vec3(direction), FINE)), *length, "line")
-            }
-            PathFeature::About { axis: a, angle } => {
-                sized(format!("about {}", axis(a)), *angle, "about")
-            }
-            PathFeature::By { angle } => format!("by {}", size("by", *angle)),
-            PathFeature::Hold => "hold".to_owned(),
-        }
-    }
-
-    /// Variables as a primitive names them: `Pw` or `(Pw Ow)`.
-    fn group(variables: &[Variable]) -> String {
-        match variables {
-            [one] => one.symbol().to_owned(),
-            many => format!("({})", symbols(many).join(" ")),
-        }
-    }
-
-    /// A primitive: `(Ow θsw).goal(..)`, `Pw.path(line ..)`, `(Pw Ow).hold`.
-    pub fn primitive(p: &Primitive) -> String {
-        let vars = group(&p.variables);
-        match &p.constraint {
-            PrimitiveConstraint::Goal(targets) => {
-                let values: Vec<String> = targets.iter().map(target).collect();
-                format!("{vars}.goal({})", values.join(", "))
-            }
-            PrimitiveConstraint::Path(f) => format!("{vars}.path({})", feature(f, true)),
-            PrimitiveConstraint::Hold => format!("{vars}.hold"),
-        }
-    }
-
-    /// `Pw Ow = ([..] m, rpy(..) deg)`.
-    fn goal(g: &Goal) -> String {
-        let vars: Vec<&str> = g.targets.iter().map(|(v, _)| v.symbol()).collect();
-        let values: Vec<String> = g.targets.iter().map(|(_, t)| target(t)).collect();
-        if values.len() == 1 {
-            format!("{} = {}", vars.join(" "), values[0])
-        } else {
-            format!("{} = ({})", vars.join(" "), values.join(", "))
-        }
-    }
-
-    /// `G` or `G1 ≻ G2`.
-    pub fn goal_constraint(g: &GoalConstraint) -> String {
-        match &g.secondary {
-            Some(secondary) => format!("{} ≻ {}", goal(&g.primary), goal(secondary)),
-            None => goal(&g.primary),
-        }
-    }
-
-    /// `Pw line [..], Ow hold : hard`.
-    pub fn path_constraint(p: &PathConstraint) -> String {
-        let items: Vec<String> = p
-            .items
-            .iter()
-            .map(|i| {
-                let vars: Vec<&str> = symbols(&i.variables);
-                format!("{} {}", vars.join(" "), feature(&i.feature, false))
-            })
-            .collect();
-        format!("{} : {}", items.join(", "), if p.hard { "hard" } else { "soft" })
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn short_numbers_drop_trailing_zeros() {
-        assert_eq!(text::short(0.4, FINE), "0.4");
-        assert_eq!(text::short(-1e-9, FINE), "0");
-        assert_eq!(text::short(96.3, COARSE), "96.3");
-        assert_eq!(text::short(10.0, COARSE), "10");
-        assert_eq!(text::short(-0.35, COARSE), "-0.35");
-    }
-
-    #[test]
-    fn values_read_as_a2ml() {
-        let r = Rotation3::from_euler_angles(0.1, -0.2, 0.3);
-        let rpy = rpy_deg(&r);
-        assert!((rpy[0] - 0.1_f64.to_degrees()).abs() < 1e-9);
-        assert!((rpy[2] - 0.3_f64.to_degrees()).abs() < 1e-9);
-        assert_eq!(text::target(&Target::Angle(0.5_f64.to_radians())), "0.5 deg");
-        assert_eq!(
-            text::target(&Target::Position(Vector3::new(0.25, -0.1, 0.0))),
-            "[0.25, -0.1, 0] m"
-        );
-        assert_eq!(text::axis(&Axis::Base(-Vector3::z())), "-z");
-        assert_eq!(text::axis(&Axis::Body(BodyAxis::L, -1.0)), "-l");
-        let p = Primitive {
-            variables: vec![Variable::Pw, Variable::Ow],
-            constraint: PrimitiveConstraint::Hold,
-        };
-        assert_eq!(text::primitive(&p), "(Pw Ow).hold");
-        let p = Primitive {
-            variables: vec![Variable::Swivel],
-            constraint: PrimitiveConstraint::Path(PathFeature::By { angle: -0.2_f64.to_radians() }),
-        };
-        assert_eq!(text::primitive(&p), "θsw.path(by -0.2 deg)");
-        let about = PathFeature::About { axis: Axis::Body(BodyAxis::R, 1.0), angle: Some(0.5) };
-        assert_eq!(text::feature(&about, true), "about r, 28.65 deg");
-        assert_eq!(text::feature(&about, false), "about r 28.65 deg");
     }
 }

@@ -139,7 +139,7 @@ fn rotated_box_corner_points_at_the_link() {
 
 #[test]
 fn cylinder_turns_with_its_rotation() {
-    // The vertical case's cylinder laid along x: its side, not its cap, now faces the link.
+    // The vertical case's cylinder laid along x: its side, not its cap, faces the link.
     let rotation = Rotation3::from_axis_angle(&Vector3::y_axis(), FRAC_PI_2);
     let p = query(
         &link(),

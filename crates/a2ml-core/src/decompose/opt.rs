@@ -16,8 +16,7 @@ use crate::kinematics::{
 };
 use crate::language::{Axis, BodyAxis, PathConstraint, PathFeature, Space, Target, Variable};
 use crate::math::{
-    JointVector, PI, Real, Rotation3, Vector3, rotation_about, rotation_distance, rotation_log,
-    wrap_angle,
+    JointVector, PI, Real, Rotation3, Vector3, rotation_about, rotation_log, wrap_angle,
 };
 use crate::robot::Robot;
 
@@ -87,16 +86,10 @@ impl ArmState {
 fn residuals(state: &ArmState, goals: &[(Variable, Target)], out: &mut Vec<Real>) {
     out.clear();
     for (v, target) in goals {
-        match (state.value(*v), target) {
-            (Target::Position(p), Target::Position(g)) => out.extend((g - p).iter()),
-            (Target::Rotation(r), Target::Rotation(g)) => {
-                out.extend(rotation_log(&(g * r.inverse())).iter())
-            }
-            (Target::Angle(a), Target::Angle(g)) => {
-                out.push(if *v == Variable::Swivel { wrap_angle(g - a) } else { g - a })
-            }
+        match v.difference(target, &state.value(*v)) {
+            Some(d) => out.extend(d.iter().take(v.dimension())),
             // The language types every target by its variable.
-            _ => out.push(Real::INFINITY),
+            None => out.push(Real::INFINITY),
         }
     }
 }
@@ -106,14 +99,9 @@ fn residuals(state: &ArmState, goals: &[(Variable, Target)], out: &mut Vec<Real>
 pub fn goal_error(state: &ArmState, goals: &[(Variable, Target)]) -> Real {
     goals
         .iter()
-        .map(|(v, target)| match (state.value(*v), target) {
-            (Target::Position(p), Target::Position(g)) => (g - p).norm(),
-            (Target::Rotation(r), Target::Rotation(g)) => rotation_distance(&r, g),
-            (Target::Angle(a), Target::Angle(g)) if *v == Variable::Swivel => {
-                wrap_angle(g - a).abs()
-            }
-            (Target::Angle(a), Target::Angle(g)) => (g - a).abs(),
-            _ => Real::INFINITY,
+        .map(|(v, target)| match v.distance(&state.value(*v), target) {
+            Some(d) => d,
+            None => Real::INFINITY,
         })
         .fold(0.0, Real::max)
 }
@@ -208,13 +196,6 @@ struct Search<'a> {
     check_path: bool,
 }
 
-fn dims(v: Variable) -> usize {
-    match v {
-        Variable::Pw | Variable::Ow | Variable::Os => 3,
-        Variable::Swivel | Variable::Elbow => 1,
-    }
-}
-
 /// A body axis at the start state, or a fixed one.
 fn axis_vector(axis: &Axis, start: &ArmState) -> Vector3 {
     match axis {
@@ -251,7 +232,7 @@ pub fn along_path(v: Variable, feature: &PathFeature, s: Real, start: &ArmState)
 
 impl Search<'_> {
     fn parameters(&self) -> usize {
-        self.free.iter().map(|v| dims(*v)).sum::<usize>() + self.sized.len()
+        self.free.iter().map(|v| v.dimension()).sum::<usize>() + self.sized.len()
     }
 
     /// The state of the search's space at fraction `f` of the way from the
@@ -272,7 +253,7 @@ impl Search<'_> {
                 }
                 Target::Angle(a) => Target::Angle(a + x[k] * fraction),
             };
-            k += dims(*v);
+            k += v.dimension();
         }
         for (v, t) in &self.fixed {
             if let Some(i) = vars.iter().position(|w| w == v) {
@@ -296,7 +277,7 @@ impl Search<'_> {
     /// The size S of every path item for parameters `x`.
     fn sizes(&self, x: &[Real]) -> Vec<Real> {
         let Some(path) = self.path else { return Vec::new() };
-        let offset = self.free.iter().map(|v| dims(*v)).sum::<usize>();
+        let offset = self.free.iter().map(|v| v.dimension()).sum::<usize>();
         path.items
             .iter()
             .enumerate()
@@ -430,14 +411,14 @@ impl Search<'_> {
             let mut x = self.initial();
             let mut i = 0;
             for v in &self.free {
-                for d in 0..dims(*v) {
+                for d in 0..v.dimension() {
                     let u = halton(k, i + d) * 2.0 - 1.0;
                     x[i + d] = match v {
                         Variable::Pw => 0.15 * u,
-                        _ => 0.9 * PI * u / (dims(*v) as Real).sqrt(),
+                        _ => 0.9 * PI * u / (v.dimension() as Real).sqrt(),
                     };
                 }
-                i += dims(*v);
+                i += v.dimension();
             }
             for (j, (_, lo, hi)) in self.sized.iter().enumerate() {
                 x[i + j] = lo + halton(k, i + j) * (hi - lo);
@@ -486,15 +467,9 @@ impl Search<'_> {
     fn offsets_to(&self, candidate: &ArmState) -> Vec<Real> {
         let mut x = Vec::with_capacity(self.parameters());
         for v in &self.free {
-            match (self.start.value(*v), candidate.value(*v)) {
-                (Target::Position(a), Target::Position(b)) => x.extend((b - a).iter()),
-                (Target::Rotation(a), Target::Rotation(b)) => {
-                    x.extend(rotation_log(&(b * a.inverse())).iter())
-                }
-                (Target::Angle(a), Target::Angle(b)) => {
-                    x.push(if *v == Variable::Swivel { wrap_angle(b - a) } else { b - a })
-                }
-                _ => x.extend(std::iter::repeat_n(0.0, dims(*v))),
+            match v.difference(&candidate.value(*v), &self.start.value(*v)) {
+                Some(d) => x.extend(d.iter().take(v.dimension())),
+                None => x.extend(std::iter::repeat_n(0.0, v.dimension())),
             }
         }
         let items = self.path.map(|p| p.items.as_slice()).unwrap_or(&[]);
@@ -622,8 +597,7 @@ fn interpolate(from: &Target, to: &Target, fraction: Real, v: Variable) -> Targe
             Target::Rotation(Rotation3::new(rotation_log(&(b * a.inverse())) * fraction) * a)
         }
         (Target::Angle(a), Target::Angle(b)) => {
-            let d = if v == Variable::Swivel { wrap_angle(b - a) } else { b - a };
-            Target::Angle(a + d * fraction)
+            Target::Angle(a + v.angle_difference(*b, *a) * fraction)
         }
         _ => *to,
     }

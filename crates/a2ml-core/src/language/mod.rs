@@ -10,11 +10,13 @@
 pub mod ast;
 mod bounds;
 mod diagnostic;
+pub mod display;
 mod edit;
 mod format;
 mod syntax;
 mod task;
 mod validate;
+mod variable;
 
 use std::path::Path;
 

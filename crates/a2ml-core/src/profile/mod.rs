@@ -1,23 +1,18 @@
-//! Bell speed profiles (eq. 9), reference paths, QP weight schedules and the joining of
-//! segments (appendix A), docs/design.md §4-5.
+//! Bell speed profiles (eq. 9), reference paths and QP weight schedules, docs/design.md §4-5;
+//! the joining of segments (appendix A) lives beside the trajectory it joins, in
+//! [`crate::trajectory::join`].
 //!
 //! Entry points: [`BellProfile`]; [`Reference`], built from a goal or a path feature and sampled
-//! as (value, velocity) at t; [`WeightSchedule`]; [`Transition`] with [`join_transitional`]
-//! (+Tr) and [`join_sequential`] (+Se). Time t is in s from the start of the primitive or
-//! segment; values and velocities are in {b}, angular velocities spatial (`Ṙ = [ω]× R`).
+//! as (value, velocity) at t; [`WeightSchedule`]. Time t is in s from the start of the primitive
+//! or segment; values and velocities are in {b}, angular velocities spatial (`Ṙ = [ω]× R`).
 
 mod bell;
 mod error;
-mod join;
 mod reference;
 mod weights;
 
 pub use bell::BellProfile;
 pub use error::ProfileError;
-pub use join::{
-    JointSample, SequentialOptions, Transition, TransitionOptions, check_sequential,
-    join_sequential, join_transitional,
-};
 pub use reference::{
     AngleReference, BodyFrames, PositionPath, PositionReference, Reference, RotationPath,
     RotationReference, Sample, resolve_axis,

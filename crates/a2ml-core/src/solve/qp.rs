@@ -38,7 +38,7 @@ use crate::kinematics::{
     ArmPose, KinematicsError, cpsa_jacobian, cpsa_state, hat_jacobian, hat_state, point_jacobian,
 };
 use crate::language::{Space, Target, Variable};
-use crate::math::{DOF, JointVector, Matrix7, Real, Vector7, rotation_log, wrap_angle};
+use crate::math::{DOF, JointVector, Matrix7, Real, Vector7, rotation_log};
 use crate::profile::{Reference, Role, Sample, WeightOptions, WeightSchedule};
 use crate::robot::Robot;
 use crate::spelling::spelled;
@@ -520,11 +520,7 @@ impl<'a> Controller<'a> {
                     3
                 }
                 (Sample::Angle { value, rate }, Target::Angle(a)) => {
-                    let e = if component.variable == Variable::Swivel {
-                        wrap_angle(value - a)
-                    } else {
-                        value - a
-                    };
+                    let e = component.variable.angle_difference(value, a);
                     errors[slot] = e.abs();
                     target[row] = rate + e * gain;
                     1
@@ -701,14 +697,9 @@ impl Resolver for Controller<'_> {
 /// rotation vector log(to fromᵀ), the angle difference (the swivel angle wrapped); angles
 /// in the first entry.
 fn difference(variable: Variable, to: &Target, from: &Target) -> crate::math::Vector3 {
-    match (to, from) {
-        (Target::Position(a), Target::Position(b)) => a - b,
-        (Target::Rotation(a), Target::Rotation(b)) => rotation_log(&(a * b.inverse())),
-        (Target::Angle(a), Target::Angle(b)) => {
-            let d = if variable == Variable::Swivel { wrap_angle(a - b) } else { a - b };
-            crate::math::Vector3::new(d, 0.0, 0.0)
-        }
-        _ => crate::math::Vector3::zeros(),
+    match variable.difference(to, from) {
+        Some(d) => d,
+        None => crate::math::Vector3::zeros(),
     }
 }
 

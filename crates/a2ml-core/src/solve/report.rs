@@ -4,8 +4,8 @@
 use crate::decompose::{ActionType, SegmentPattern};
 use crate::language::{SolverChoice, Space, Variable};
 use crate::math::{Real, UnitQuaternion, Vector3};
-use crate::spelling::spelled;
 use crate::solve::map::MapSummary;
+use crate::spelling::spelled;
 use crate::trajectory::{CapsuleDistances, Clearance, Trajectory};
 
 /// How close a goal must be reached.

@@ -1,7 +1,8 @@
 //! Sampled joint trajectories (time, q, q' per sample), their joining with +Tr blends and +Se
 //! (docs/design.md §4, §5) and the checks run on the whole result: joint limits and clearance.
 //!
-//! Entry points: [`Trajectory::new`], [`join_sequential`], [`join_transitional`],
+//! Entry points: [`Trajectory::new`], [`join_sequential`], [`join_transitional`] (over the
+//! joins of [`join`], which take any function of time),
 //! [`check_limits`], [`peaks`], [`min_clearance`], [`distance_pass`] (per sample, both),
 //! [`sample_times`] (the output grid),
 //! [`Trajectory::stretched`]. Between samples q follows the cubic Hermite curve through the
@@ -11,15 +12,17 @@
 use crate::collision::{self, CollisionScene};
 use crate::kinematics::arm_pose;
 use crate::math::{DOF, JointVector, Real};
-use crate::profile::{self, JointSample, ProfileError, SequentialOptions, Transition};
+use crate::profile::ProfileError;
 use crate::robot::Robot;
 
 mod distances;
+pub mod join;
 mod limits;
 #[cfg(test)]
 mod tests;
 
 pub use distances::{CapsuleDistances, DistancePass, capsule_distances, distance_pass};
+pub use join::{JointSample, SequentialOptions, Transition, TransitionOptions, check_sequential};
 pub use limits::{Limits, Peaks, peaks};
 
 /// Largest |q2(0) - q1(T1)| per joint accepted by [`join_sequential`] (rad).
@@ -273,7 +276,7 @@ pub fn join_sequential(
     let options =
         SequentialOptions { position_tolerance: SEQUENTIAL_GAP, ..SequentialOptions::default() };
     let t1 = first.duration();
-    let joined = profile::join_sequential(first.local(), t1, second.local(), &options)?;
+    let joined = join::sequential(first.local(), t1, second.local(), &options)?;
     let times = first.times.iter().map(|t| t - first.start());
     let later = second.times.iter().skip(1).map(|t| t - second.start() + t1);
     let times: Vec<Real> = merge_times(times.chain(later).collect());
@@ -296,7 +299,7 @@ pub fn join_transitional(
     overlap: Real,
 ) -> Result<Trajectory, TrajectoryError> {
     let transition = Transition::new(first.duration(), second.duration(), overlap)?;
-    let joined = profile::join_transitional(first.local(), second.local(), transition);
+    let joined = join::transitional(first.local(), second.local(), transition);
     let t2s = transition.second_start();
     let mut times: Vec<Real> = first.times.iter().map(|t| t - first.start()).collect();
     times.extend(second.times.iter().map(|t| t - second.start() + t2s));

@@ -4,9 +4,11 @@
 //! A trajectory is anything that gives joint positions and velocities at a time,
 //! `Fn(Real) -> JointSample`, each in its own time starting at 0. The joined trajectory is
 //! again such a function, so joins chain: join the first two, then the result with the third.
+//! [`transitional`] and [`sequential`] join such functions; [`super::join_transitional`] and
+//! [`super::join_sequential`] join sampled [`super::Trajectory`]s through them.
 
-use super::ProfileError;
 use crate::math::{DOF, JointVector, PI, Real};
+use crate::profile::ProfileError;
 
 /// Joint positions q (rad) and velocities q' (rad/s) at one instant.
 pub type JointSample = (JointVector, JointVector);
@@ -131,7 +133,7 @@ impl Transition {
 /// The transitional connection +Tr (appendix A): `first` (local time in [0, T1]) up to t2s,
 /// the blend over [t2s, t1e], then `second` (called with its local time t - t2s). The
 /// result is continuous in q and q' at both seams whenever the inputs are, since β' = 0 there.
-pub fn join_transitional<F1, F2>(
+pub fn transitional<F1, F2>(
     first: F1,
     second: F2,
     transition: Transition,
@@ -204,7 +206,7 @@ pub fn check_sequential(
 ///
 /// # Errors
 /// As [`check_sequential`]; [`ProfileError::InvalidDuration`] for a negative or non-finite T1.
-pub fn join_sequential<F1, F2>(
+pub fn sequential<F1, F2>(
     first: F1,
     first_duration: Real,
     second: F2,
@@ -260,7 +262,7 @@ mod tests {
     #[test]
     fn zero_overlap_switches() {
         let tr = Transition::new(1.0, 1.0, 0.0).expect("valid");
-        let joined = join_transitional(constant(1.0), constant(2.0), tr);
+        let joined = transitional(constant(1.0), constant(2.0), tr);
         assert_eq!(joined(1.0).0[0], 1.0);
         assert_eq!(joined(1.0 + 1e-12).0[0], 2.0);
     }
@@ -268,15 +270,15 @@ mod tests {
     #[test]
     fn sequential_checks_the_seam() {
         let options = SequentialOptions::default();
-        let joined = join_sequential(constant(0.5), 1.0, constant(0.5), &options).expect("at rest");
+        let joined = sequential(constant(0.5), 1.0, constant(0.5), &options).expect("at rest");
         assert_eq!(joined(1.5).0[3], 0.5);
         assert!(matches!(
-            join_sequential(constant(0.5), 1.0, constant(0.6), &options),
+            sequential(constant(0.5), 1.0, constant(0.6), &options),
             Err(ProfileError::Discontinuous { .. })
         ));
         let moving = |_: Real| (JointVector::repeat(0.5), JointVector::from_fn(|i, _| i as Real));
         assert!(matches!(
-            join_sequential(constant(0.5), 1.0, moving, &options),
+            sequential(constant(0.5), 1.0, moving, &options),
             Err(ProfileError::NotAtRest { joint: 6, .. })
         ));
         let broken = |_: Real| {
