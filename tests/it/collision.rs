@@ -171,21 +171,76 @@ fn empty_scene_keeps_self_pairs_only() {
     let pose = arm_pose(&robot, &random_q(&robot, &mut rng(3)));
     let scene = CollisionScene::new(&[]);
     let all = distances(&robot, &pose, &scene, &DistanceOptions { influence: 1e3 });
-    let role = |name: &str| {
-        robot.capsules.iter().find(|c| c.name == name).map(|c| c.role).expect("a capsule")
-    };
+    let index = |name: &str| robot.capsules.iter().position(|c| c.name == name).expect("a capsule");
     for p in &all {
-        assert!(self_pairs().contains(&(role(&p.link), role(&p.obstacle))), "{p:?}");
+        let pair = (index(&p.link), index(&p.obstacle));
+        assert!(robot.self_pairs.contains(&pair), "{p:?}");
     }
-    let expected: usize = self_pairs()
-        .iter()
-        .map(|(m, a)| {
-            let count = |r: &LinkRole| robot.capsules.iter().filter(|c| c.role == *r).count();
-            count(m) * count(a)
-        })
-        .sum();
-    assert_eq!(all.len(), expected);
-    assert_eq!(min_distance(&robot, &pose, &scene).is_some(), expected > 0);
+    assert_eq!(all.len(), robot.self_pairs.len());
+    assert_eq!(min_distance(&robot, &pose, &scene).is_some(), !robot.self_pairs.is_empty());
+}
+
+/// The self pairs follow from the geometry: never between adjacent bodies (no body carrying
+/// geometry between them), never in contact at home, the farther capsule first; the Panda's hand is checked against its upper arm and
+/// base, and an SRDF beside the URDF removes the pairs it disables.
+#[test]
+fn self_pairs_come_from_the_geometry_and_the_srdf() {
+    for (name, robot) in all_robots() {
+        let home = arm_pose(&robot, &a2ml::robot::home(&robot.joints));
+        let capsules = a2ml::collision::arm_capsules(&robot, &home);
+        for &(a, b) in &robot.self_pairs {
+            let (ca, cb) = (&robot.capsules[a], &robot.capsules[b]);
+            let between = robot.capsules.iter().any(|c| c.frame > cb.frame && c.frame < ca.frame);
+            assert!(ca.frame > cb.frame + 1 && between, "{name}: {} {}", ca.name, cb.name);
+            let (pa, pb) = (&capsules[a], &capsules[b]);
+            let d = a2ml::math::segment_segment_distance(&pa.a, &pa.b, &pb.a, &pb.b)
+                - pa.radius
+                - pb.radius;
+            assert!(
+                d >= a2ml::robot::SELF_CONTACT_MARGIN,
+                "{name}: {} {} at {d}",
+                ca.name,
+                cb.name
+            );
+        }
+    }
+    let panda = load("panda");
+    let named = |robot: &a2ml::Robot, a: &str, b: &str| {
+        robot
+            .self_pairs
+            .iter()
+            .any(|&(i, j)| robot.capsules[i].name == a && robot.capsules[j].name == b)
+    };
+    assert!(named(&panda, "finger_left", "upper_arm"));
+    assert!(named(&panda, "gripper_0", "base"));
+    // The same URDF with an SRDF beside it.
+    let dir = std::env::temp_dir().join(format!("a2ml_srdf_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temporary folder");
+    let urdf = std::fs::read_to_string(crate::common::robot_path("panda")).expect("urdf");
+    std::fs::write(dir.join("panda.urdf"), &urdf).expect("write");
+    std::fs::write(
+        dir.join("panda.srdf"),
+        "<robot name=\"panda\">\n  <disable_collisions link1=\"hand\" link2=\"panda_link3\" \
+         reason=\"Never\"/>\n</robot>\n",
+    )
+    .expect("write");
+    let with_srdf = a2ml::Robot::from_urdf_file(dir.join("panda.urdf")).expect("loads");
+    assert_eq!(with_srdf.allowed_pairs, vec![("hand".to_owned(), "panda_link3".to_owned())]);
+    assert!(!named(&with_srdf, "finger_left", "upper_arm"));
+    assert!(named(&with_srdf, "gripper_0", "base"));
+    // A bad SRDF is a located error.
+    std::fs::write(
+        dir.join("panda.srdf"),
+        "<robot>\n\n  <disable_collisions link1=\"hand\" link2=\"panda_link33\"/>\n</robot>",
+    )
+    .expect("write");
+    match a2ml::Robot::from_urdf_file(dir.join("panda.urdf")) {
+        Err(a2ml::RobotError::Srdf { line: Some(3), message, path: Some(_) }) => {
+            assert!(message.contains("panda_link33"), "{message}")
+        }
+        other => panic!("{other:?}"),
+    }
+    std::fs::remove_dir_all(&dir).expect("clean up");
 }
 
 #[test]

@@ -1,5 +1,5 @@
-//! MotionBenchMaker scenes (tests/data/mbm): rotated boxes and cylinders read into a scene,
-//! and joint-space RRT paths among them re-checked densely and independently.
+//! The seven MotionBenchMaker scenes (tests/data/mbm): rotated boxes and cylinders read into
+//! a scene, and joint-space RRT paths among them re-checked densely and independently.
 
 use a2ml::collision::{CollisionScene, min_distance};
 use a2ml::kinematics::arm_pose;
@@ -8,14 +8,14 @@ use a2ml::math::{Matrix3, Real};
 use a2ml::solve::rrt::{RrtError, RrtOptions, rrt_connect};
 
 use crate::common::load;
-use crate::mbm_problems::problems;
+use crate::mbm_problems::{SCENES, problems};
 
 #[test]
 fn motion_bench_maker_paths_keep_the_clearance() {
     let robot = load("panda");
-    let options = RrtOptions { max_samples: 5000, ..RrtOptions::default() };
+    let options = RrtOptions::default();
     let mut solved = 0;
-    for scene_name in ["bookshelf_small", "table_pick"] {
+    for scene_name in SCENES {
         let problems = problems(scene_name);
         assert_eq!(problems.len(), 100);
         for problem in problems.iter().take(4) {
@@ -29,8 +29,13 @@ fn motion_bench_maker_paths_keep_the_clearance() {
             let scene = CollisionScene::new(&problem.obstacles);
             let path = match rrt_connect(&robot, &scene, &problem.start, &problem.goals, &options) {
                 Ok(path) => path,
-                // The capsule model may find an end invalid that VAMP's spheres find clear.
-                Err(RrtError::InvalidStart { .. } | RrtError::NoValidGoal { .. }) => continue,
+                // The capsule model may find an end invalid that VAMP's spheres find clear, and
+                // a search may use its budget: counted as unsolved, and bounded below.
+                Err(
+                    RrtError::InvalidStart { .. }
+                    | RrtError::NoValidGoal { .. }
+                    | RrtError::NoPath { .. },
+                ) => continue,
                 Err(e) => panic!("{scene_name}: {e}"),
             };
             solved += 1;
@@ -45,5 +50,5 @@ fn motion_bench_maker_paths_keep_the_clearance() {
             }
         }
     }
-    assert!(solved >= 4, "only {solved} of 8 problems solved");
+    assert!(solved >= 14, "only {solved} of 28 problems solved");
 }

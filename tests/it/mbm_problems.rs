@@ -4,6 +4,17 @@
 use a2ml::language::{Obstacle, Shape};
 use a2ml::math::{JointVector, Real, UnitQuaternion, Vector3};
 
+/// The scenes of tests/data/mbm, 100 problems each.
+pub const SCENES: [&str; 7] = [
+    "bookshelf_small",
+    "bookshelf_tall",
+    "bookshelf_thin",
+    "box",
+    "cage",
+    "table_pick",
+    "table_under_pick",
+];
+
 /// A problem: start, goals and obstacles in {b} (S is 0.333 m above `panda_link0`).
 pub struct Problem {
     pub start: JointVector,

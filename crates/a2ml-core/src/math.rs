@@ -140,6 +140,42 @@ pub fn solve_trig(a: Real, b: Real, c: Real) -> Vec<Real> {
     }
 }
 
+/// Distance between the segments p1–q1 and p2–q2 (Ericson, Real-Time Collision Detection
+/// §5.1.9).
+pub fn segment_segment_distance(p1: &Vector3, q1: &Vector3, p2: &Vector3, q2: &Vector3) -> Real {
+    let (d1, d2, r) = (q1 - p1, q2 - p2, p1 - p2);
+    let (a, e, f) = (d1.norm_squared(), d2.norm_squared(), d2.dot(&r));
+    let tiny = Real::MIN_POSITIVE;
+    let (s, t) = if a <= tiny && e <= tiny {
+        (0.0, 0.0)
+    } else if a <= tiny {
+        (0.0, (f / e).clamp(0.0, 1.0))
+    } else {
+        let c = d1.dot(&r);
+        if e <= tiny {
+            ((-c / a).clamp(0.0, 1.0), 0.0)
+        } else {
+            let b = d1.dot(&d2);
+            let denominator = a * e - b * b;
+            // Parallel segments: any s works; start from p1.
+            let s = if denominator > 0.0 {
+                ((b * f - c * e) / denominator).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let t = (b * s + f) / e;
+            if t < 0.0 {
+                ((-c / a).clamp(0.0, 1.0), 0.0)
+            } else if t > 1.0 {
+                (((b - c) / a).clamp(0.0, 1.0), 1.0)
+            } else {
+                (s, t)
+            }
+        }
+    };
+    ((p1 + d1 * s) - (p2 + d2 * t)).norm()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

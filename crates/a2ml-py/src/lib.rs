@@ -17,6 +17,7 @@ mod metrics;
 mod plan;
 mod plot;
 mod robot;
+mod rrt;
 
 use pyo3::prelude::*;
 
@@ -43,6 +44,7 @@ fn _a2ml(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<plan::PyPlan>()?;
     m.add_class::<plan::PySegmentReport>()?;
     m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
+    rrt::register(m)?;
     m.add_function(wrap_pyfunction!(plan::plan_many, m)?)?;
     m.add_function(wrap_pyfunction!(compare::compare, m)?)?;
     m.add_function(wrap_pyfunction!(map::swivel_map, m)?)?;

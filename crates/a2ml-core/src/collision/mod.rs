@@ -24,7 +24,9 @@ mod guard;
 mod model;
 
 pub use guard::{ShapeError, check_shapes};
-pub use model::{CollisionModel, advancement, advancement_at_least, clearance, motion_bound};
+pub use model::{
+    CollisionModel, advancement, advancement_at_least, advancement_within, clearance, motion_bound,
+};
 
 /// The task's obstacles as parry shapes, positioned in {b}.
 ///
@@ -129,8 +131,8 @@ pub fn arm_capsules(robot: &Robot, pose: &ArmPose) -> Vec<PosedCapsule> {
         .collect()
 }
 
-/// Every moving link capsule × obstacle pair, plus the self-collision pairs
-/// (see [`self_pairs`]), closer than `options.influence`.
+/// Every moving link capsule × obstacle pair, plus the robot's self-collision pairs
+/// ([`Robot::self_pairs`]), closer than `options.influence`.
 ///
 /// Pairs whose bounding spheres are already `influence` apart are skipped
 /// without a narrow-phase query.
@@ -179,18 +181,6 @@ pub fn min_distance(
         }
     });
     best
-}
-
-/// Self-collision pairs (first the moving link, second the one treated as
-/// the obstacle): hand vs upper arm, hand vs base, forearm vs base. Base
-/// vs upper arm is skipped: they touch at the shoulder by construction, as
-/// do neighbouring parts at the elbow and wrist.
-pub fn self_pairs() -> &'static [(LinkRole, LinkRole)] {
-    &[
-        (LinkRole::Hand, LinkRole::UpperArm),
-        (LinkRole::Hand, LinkRole::Base),
-        (LinkRole::Forearm, LinkRole::Base),
-    ]
 }
 
 /// A convex body in {b}: a parry shape, its pose, and a radius added
@@ -307,19 +297,17 @@ fn for_each_pair(
     mut f: impl FnMut(&Body, &Body),
 ) {
     let capsules = arm_capsules(robot, pose);
-    let bodies: Vec<(LinkRole, Body)> =
-        capsules.iter().map(|c| (c.role, Body::from_capsule(c))).collect();
-    for (role, link) in bodies.iter().filter(|(r, _)| *r != LinkRole::Base) {
+    let bodies: Vec<Body> = capsules.iter().map(Body::from_capsule).collect();
+    for (link, capsule) in bodies.iter().zip(&capsules) {
+        if capsule.role == LinkRole::Base {
+            continue;
+        }
         for obstacle in &scene.bodies {
             f(link, obstacle);
         }
-        for (_, other) in self_pairs()
-            .iter()
-            .filter(|(moving, _)| moving == role)
-            .flat_map(|(_, against)| bodies.iter().filter(move |(r, _)| r == against))
-        {
-            f(link, other);
-        }
+    }
+    for &(link, other) in &robot.self_pairs {
+        f(&bodies[link], &bodies[other]);
     }
 }
 

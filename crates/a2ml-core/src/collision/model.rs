@@ -2,37 +2,103 @@
 //! configurations, without allocating: closed-form capsule–sphere and capsule–capsule
 //! distances, parry only for boxes and cylinders.
 
-use parry3d_f64::math::Pose;
+use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query;
 use parry3d_f64::shape::Segment;
 
-use super::{Body, CollisionScene, Core, self_pairs, to_parry};
-use crate::math::{DOF, JointVector, Matrix3, PI, Real, Rotation3, Vector3};
+use super::{Body, CollisionScene, Core, from_parry, to_parry};
+use crate::kinematics::{AlignedChain, Frame};
+use crate::math::{
+    DOF, JointVector, Matrix3, PI, Real, Rotation3, Vector3, segment_segment_distance,
+};
 use crate::robot::{LinkRole, Robot};
 
 /// The arm's capsules and a scene's obstacles, prepared for [`clearance`] and
 /// [`advancement`] at many configurations.
 ///
 /// It considers the same pairs as [`super::min_distance`]: every moving link capsule against
-/// every obstacle, plus [`self_pairs`].
+/// every obstacle, plus the robot's self-collision pairs ([`Robot::self_pairs`]).
 #[derive(Debug, Clone)]
 pub struct CollisionModel {
-    chain: Chain,
+    chain: AlignedChain,
     links: Vec<LinkCapsule>,
-    /// Indices into `links` of the capsules that move.
-    moving: Vec<usize>,
+    /// The capsules that move, a few of one frame at a time, each group with its bounding
+    /// sphere: the broadphase that keeps the cost of a check growing with the obstacles near
+    /// the arm rather than with every capsule × obstacle.
+    groups: Vec<Group>,
     spheres: Vec<Sphere>,
     capsules: Vec<Capsule>,
-    /// Boxes and cylinders, through parry.
-    convex: Vec<Body>,
+    /// Boxes and cylinders: parry for segments, closed forms for points.
+    convex: Vec<Convex>,
+    /// Sorted by the pair of groups, so that [`GroupPair`] ranges cover them.
     self_pairs: Vec<SelfPair>,
+    group_pairs: Vec<GroupPair>,
+}
+
+/// At most this many capsules per [`Group`], so that a check keeps their running bounds on
+/// the stack.
+const GROUP_SIZE: usize = 16;
+
+/// Capsules of one moving frame (a frame with more than [`GROUP_SIZE`] has several groups).
+#[derive(Debug, Clone)]
+struct Group {
+    frame: usize,
+    /// Indices into `links`.
+    members: Vec<usize>,
+    /// Bounding sphere of the members (segments and radii), in the aligned frame.
+    center: Vector3,
+    bound: Real,
+    /// The largest lever of the members per joint, so that no member moves farther.
+    levers: JointVector,
+}
+
+/// The self pairs `pairs` (a range of `self_pairs`) between the capsules of two groups.
+#[derive(Debug, Clone)]
+struct GroupPair {
+    groups: (usize, usize),
+    pairs: std::ops::Range<usize>,
+    /// The largest levers of those pairs.
+    levers: JointVector,
+}
+
+/// A box or cylinder: the parry body, and what the closed forms for a point need.
+#[derive(Debug, Clone)]
+struct Convex {
+    body: Body,
+    /// {b} from the shape's own axes (a cylinder's axis is its z).
+    rotation: Matrix3,
+    solid: Solid,
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Solid {
+    Cuboid { half: Vector3 },
+    Cylinder { radius: Real, half_height: Real },
+}
+
+impl Convex {
+    /// The signed distance from `p` to the solid (negative inside: the depth).
+    fn point_distance(&self, p: &Vector3) -> Real {
+        let local = self.rotation.tr_mul(&(p - self.body.center));
+        match self.solid {
+            Solid::Cuboid { half } => {
+                let d = local.abs() - half;
+                d.sup(&Vector3::zeros()).norm() + d.max().min(0.0)
+            }
+            Solid::Cylinder { radius, half_height } => {
+                let radial = local.x.hypot(local.y) - radius;
+                let axial = local.z.abs() - half_height;
+                radial.max(0.0).hypot(axial.max(0.0)) + radial.max(axial).min(0.0)
+            }
+        }
+    }
 }
 
 /// A robot capsule in its moving frame.
 #[derive(Debug, Clone)]
 struct LinkCapsule {
     frame: usize,
-    /// Segment ends in the aligned frame (see [`Chain`]).
+    /// Segment ends in the aligned frame (see [`AlignedChain`]).
     a: Vector3,
     b: Vector3,
     radius: Real,
@@ -73,7 +139,7 @@ impl CollisionModel {
     /// Prepares `robot`'s capsules against `scene`.
     pub fn new(robot: &Robot, scene: &CollisionScene) -> Self {
         let last = robot.capsules.iter().map(|c| c.frame).max().unwrap_or(0);
-        let chain = Chain::new(robot, last);
+        let chain = AlignedChain::new(robot, last);
         let links: Vec<LinkCapsule> = robot
             .capsules
             .iter()
@@ -85,16 +151,44 @@ impl CollisionModel {
                 levers: levers(robot, c.frame, &c.a, &c.b),
             })
             .collect();
-        let role = |i: usize| robot.capsules[i].role;
-        let moving = (0..links.len()).filter(|&i| role(i) != LinkRole::Base).collect();
-        let count = links.len();
-        let with_role = move |r: LinkRole| (0..count).filter(move |&i| role(i) == r);
-        let self_pairs = self_pairs()
+        let mut groups: Vec<Group> = Vec::new();
+        for (i, capsule) in robot.capsules.iter().enumerate() {
+            if capsule.role == LinkRole::Base {
+                continue;
+            }
+            match groups
+                .iter_mut()
+                .find(|g| g.frame == capsule.frame && g.members.len() < GROUP_SIZE)
+            {
+                Some(group) => group.members.push(i),
+                None => groups.push(Group {
+                    frame: capsule.frame,
+                    members: vec![i],
+                    center: Vector3::zeros(),
+                    bound: 0.0,
+                    levers: JointVector::zeros(),
+                }),
+            }
+        }
+        for group in &mut groups {
+            let ends = || group.members.iter().flat_map(|&i| [&links[i].a, &links[i].b]);
+            let count = 2.0 * group.members.len() as Real;
+            group.center = ends().sum::<Vector3>() / count;
+            group.bound = group
+                .members
+                .iter()
+                .map(|&i| {
+                    let l = &links[i];
+                    (l.a - group.center).norm().max((l.b - group.center).norm()) + l.radius
+                })
+                .fold(0.0, Real::max);
+            group.levers =
+                group.members.iter().fold(JointVector::zeros(), |m, &i| m.sup(&links[i].levers));
+        }
+        let mut self_pairs: Vec<SelfPair> = robot
+            .self_pairs
             .iter()
-            .flat_map(|&(moving, against)| {
-                with_role(moving).flat_map(move |i| with_role(against).map(move |j| (i, j)))
-            })
-            .map(|(link, other)| {
+            .map(|&(link, other)| {
                 let (f, g) = (links[link].frame, links[other].frame);
                 let distal = if f >= g { link } else { other };
                 let joints = f.min(g)..f.max(g);
@@ -104,6 +198,22 @@ impl CollisionModel {
                 SelfPair { link, other, distal, joints, levers }
             })
             .collect();
+        let group_of = |capsule: usize| groups.iter().position(|g| g.members.contains(&capsule));
+        // A base capsule never moves: it has no group, and stands for itself.
+        let key = |pair: &SelfPair| (group_of(pair.link), group_of(pair.other));
+        self_pairs.sort_by_key(|p| (key(p), p.link, p.other));
+        let mut group_pairs: Vec<GroupPair> = Vec::new();
+        for (k, pair) in self_pairs.iter().enumerate() {
+            let (a, b) = key(pair);
+            let groups = (a.unwrap_or(usize::MAX), b.unwrap_or(usize::MAX));
+            match group_pairs.last_mut() {
+                Some(last) if last.groups == groups => {
+                    last.pairs.end = k + 1;
+                    last.levers = last.levers.sup(&pair.levers);
+                }
+                _ => group_pairs.push(GroupPair { groups, pairs: k..k + 1, levers: pair.levers }),
+            }
+        }
         let (mut spheres, mut capsules, mut convex) = (Vec::new(), Vec::new(), Vec::new());
         for body in &scene.bodies {
             match body.shape {
@@ -117,17 +227,33 @@ impl CollisionModel {
                     b: Vector3::new(s.b.x, s.b.y, s.b.z),
                     radius: body.margin,
                 }),
-                Core::Cuboid(_) | Core::Cylinder(_) => convex.push(body.clone()),
+                Core::Cuboid(cuboid) => convex.push(Convex {
+                    body: body.clone(),
+                    rotation: rotation_of(&body.pose),
+                    solid: Solid::Cuboid { half: from_parry(cuboid.half_extents) },
+                }),
+                Core::Cylinder(cylinder) => {
+                    // parry's cylinder runs along its y; the closed form wants it along z.
+                    let z_to_y = Rotation3::from_axis_angle(&Vector3::x_axis(), -PI / 2.0);
+                    convex.push(Convex {
+                        body: body.clone(),
+                        rotation: rotation_of(&body.pose) * z_to_y.matrix(),
+                        solid: Solid::Cylinder {
+                            radius: cylinder.radius,
+                            half_height: cylinder.half_height,
+                        },
+                    })
+                }
             }
         }
-        Self { chain, links, moving, spheres, capsules, convex, self_pairs }
+        Self { chain, links, groups, spheres, capsules, convex, self_pairs, group_pairs }
     }
 }
 
 /// The smallest signed distance (m, negative for a penetration) over the pairs of
 /// [`super::min_distance`] with the arm at `q`; ∞ when there is no pair.
 pub fn clearance(model: &CollisionModel, q: &JointVector) -> Real {
-    model.smallest(q, 0.0, None, Real::NEG_INFINITY)
+    model.smallest(q, 0.0, None, Real::NEG_INFINITY, Real::INFINITY)
 }
 
 /// How far the arm at `q` can move along the straight joint-space motion `dq`, either way,
@@ -148,7 +274,7 @@ pub fn advancement(
     dq: &JointVector,
     clearance: Real,
 ) -> Real {
-    model.smallest(q, clearance, Some(&dq.abs()), Real::NEG_INFINITY)
+    model.smallest(q, clearance, Some(&dq.abs()), Real::NEG_INFINITY, Real::INFINITY)
 }
 
 /// [`advancement`] if it is at least `least`, else `None`: a check that only needs to know
@@ -160,7 +286,22 @@ pub fn advancement_at_least(
     clearance: Real,
     least: Real,
 ) -> Option<Real> {
-    let found = model.smallest(q, clearance, Some(&dq.abs()), least);
+    advancement_within(model, q, dq, clearance, least, Real::INFINITY)
+}
+
+/// [`advancement_at_least`] capped at `enough`: the smaller of the advancement and `enough`
+/// if that is at least `least`. A check that has no use for more than `enough` (an edge
+/// check covering a stretch of that half-length) leaves out every pair that cannot come
+/// that near, which is most of them.
+pub fn advancement_within(
+    model: &CollisionModel,
+    q: &JointVector,
+    dq: &JointVector,
+    clearance: Real,
+    least: Real,
+    enough: Real,
+) -> Option<Real> {
+    let found = model.smallest(q, clearance, Some(&dq.abs()), least, enough);
     (found >= least).then_some(found)
 }
 
@@ -172,15 +313,16 @@ pub fn motion_bound(model: &CollisionModel, dq: &JointVector) -> Real {
 }
 
 impl CollisionModel {
-    /// The smallest `reach(d − offset)` over the pairs, d the signed distance of a pair and
-    /// `reach` the advancement its [`Motion`] along `speed` (|dq|) allows; with no motion,
-    /// the smallest d − offset.
+    /// The smallest `reach(d − offset)` over the pairs, at most `enough`, d the signed
+    /// distance of a pair and `reach` the advancement its [`Motion`] along `speed` (|dq|)
+    /// allows; with no motion, the smallest d − offset. Stops below `least`.
     fn smallest(
         &self,
         q: &JointVector,
         offset: Real,
         speed: Option<&JointVector>,
         least: Real,
+        enough: Real,
     ) -> Real {
         let frames = self.chain.frames(q);
         // The configuration-independent motion bound first: cheap, and never below the
@@ -191,75 +333,170 @@ impl CollisionModel {
         let exact = |link: &Posed, levers: &JointVector, joints: std::ops::Range<usize>| {
             speed.map_or(Motion::UNIT, |speed| Motion::new(&frames, link, levers, speed, joints))
         };
-        let mut best = Real::INFINITY;
-        for &i in &self.moving {
-            let capsule = &self.links[i];
-            let link = capsule.posed(&frames);
-            // Only distances (between the segment and an obstacle's core) below this may lower
-            // `best`; it falls to the nearest found.
-            let mut below = offset + loose(&capsule.levers).threshold(best) + link.radius;
-            // Whether an obstacle was found below the bound: without one, the capsule cannot
-            // lower `best`, and the bound itself is no distance (rounded, it can even put a
-            // capsule that cannot move a hair inside the clearance).
-            let mut found = false;
+        let mut best = enough;
+        for group in &self.groups {
+            let frame = &frames[group.frame];
+            let center = frame.apply(&group.center);
+            // Obstacles whose distance from the group's bounding sphere is this or more
+            // cannot lower `best` through any member.
+            let near = offset + loose(&group.levers).threshold(best);
+            let n = group.members.len();
+            let mut posed: [Option<Posed>; GROUP_SIZE] = Default::default();
+            // Per member: only distances (between its segment and an obstacle's core) below
+            // `below` may lower `best`; it falls to the nearest found. `found`: an obstacle
+            // was found below the bound (without one the member cannot lower `best`, and the
+            // bound itself is no distance: rounded, it can even put a capsule that cannot move
+            // a hair inside the clearance).
+            let mut below = [0.0; GROUP_SIZE];
+            let mut found = [false; GROUP_SIZE];
+            for (m, &i) in group.members.iter().enumerate() {
+                let capsule = &self.links[i];
+                below[m] = offset + loose(&capsule.levers).threshold(best) + capsule.radius;
+            }
+            // Members are placed when an obstacle first comes near the group.
+            let place = |m: usize| self.links[group.members[m]].posed(&frames);
             for sphere in &self.spheres {
-                let reach = below + sphere.radius;
-                if reach > 0.0 {
-                    let squared = link.squared_distance_to_point(&sphere.center);
-                    if squared < reach * reach {
-                        below = squared.sqrt() - sphere.radius;
-                        found = true;
-                    }
+                if (center - sphere.center).norm() - group.bound - sphere.radius >= near {
+                    continue;
                 }
-            }
-            for capsule in &self.capsules {
-                let reach = below + capsule.radius;
-                if reach > 0.0 {
-                    let distance =
-                        segment_segment_distance(&link.a, &link.b, &capsule.a, &capsule.b);
-                    if distance < reach {
-                        below = distance - capsule.radius;
-                        found = true;
-                    }
-                }
-            }
-            for body in &self.convex {
-                let gap = (link.center - body.center).norm() - link.bound - body.bound;
-                if gap < below - link.radius {
-                    if let Some(distance) = link.convex_distance(body, below) {
-                        if distance < below {
-                            below = distance;
-                            found = true;
+                for m in 0..n {
+                    let reach = below[m] + sphere.radius;
+                    if reach > 0.0 {
+                        let squared = posed[m]
+                            .get_or_insert_with(|| place(m))
+                            .squared_distance_to_point(&sphere.center);
+                        if squared < reach * reach {
+                            below[m] = squared.sqrt() - sphere.radius;
+                            found[m] = true;
                         }
                     }
                 }
             }
-            if !found {
-                continue;
+            for capsule in &self.capsules {
+                let gap = (center - 0.5 * (capsule.a + capsule.b)).norm()
+                    - group.bound
+                    - 0.5 * (capsule.b - capsule.a).norm()
+                    - capsule.radius;
+                if gap >= near {
+                    continue;
+                }
+                for m in 0..n {
+                    let reach = below[m] + capsule.radius;
+                    if reach > 0.0 {
+                        let link = posed[m].get_or_insert_with(|| place(m));
+                        let distance =
+                            segment_segment_distance(&link.a, &link.b, &capsule.a, &capsule.b);
+                        if distance < reach {
+                            below[m] = distance - capsule.radius;
+                            found[m] = true;
+                        }
+                    }
+                }
             }
-            let slack = below - link.radius - offset;
-            if loose(&capsule.levers).reach(slack) < best {
-                best = best.min(exact(&link, &capsule.levers, 0..capsule.frame).reach(slack));
-                if best < least {
-                    return best;
+            for convex in &self.convex {
+                let body = &convex.body;
+                if (center - body.center).norm() - group.bound - body.bound >= near {
+                    continue;
+                }
+                for m in 0..n {
+                    let link = posed[m].get_or_insert_with(|| place(m));
+                    let gap = (link.center - body.center).norm() - link.bound - body.bound;
+                    if gap >= below[m] - link.radius {
+                        continue;
+                    }
+                    let distance = if link.inverse_squared_length == 0.0 {
+                        // A sphere: the exact point distance, without parry's machinery.
+                        Some(convex.point_distance(&link.a))
+                    } else {
+                        link.convex_distance(body, below[m])
+                    };
+                    if let Some(distance) = distance {
+                        if distance < below[m] {
+                            below[m] = distance;
+                            found[m] = true;
+                        }
+                    }
+                }
+            }
+            for m in 0..n {
+                if !found[m] {
+                    continue;
+                }
+                let capsule = &self.links[group.members[m]];
+                let slack = below[m] - capsule.radius - offset;
+                if loose(&capsule.levers).reach(slack) < best {
+                    let link = posed[m].get_or_insert_with(|| place(m));
+                    best = best.min(exact(link, &capsule.levers, 0..capsule.frame).reach(slack));
+                    if best < least {
+                        return best;
+                    }
                 }
             }
         }
-        for pair in &self.self_pairs {
-            let (link, other) =
-                (self.links[pair.link].posed(&frames), self.links[pair.other].posed(&frames));
-            let moved = if pair.distal == pair.link { &link } else { &other };
-            let loose = loose(&pair.levers);
-            if link.gap_bound(&other) - offset < loose.threshold(best) {
-                let slack = link.distance(&other) - offset;
-                if loose.reach(slack) < best {
-                    let exact = exact(moved, &pair.levers, pair.joints.clone());
-                    best = best.min(exact.reach(slack));
+        // A capsule is in many self pairs: placed once.
+        let mut placed = Placed::new();
+        let bounding = |group: usize| {
+            self.groups.get(group).map(|g| (frames[g.frame].apply(&g.center), g.bound))
+        };
+        for group_pair in &self.group_pairs {
+            let loose_pair = loose(&group_pair.levers);
+            if let (Some((ca, ba)), Some((cb, bb))) =
+                (bounding(group_pair.groups.0), bounding(group_pair.groups.1))
+            {
+                if (ca - cb).norm() - ba - bb - offset >= loose_pair.threshold(best) {
+                    continue;
+                }
+            }
+            for pair in &self.self_pairs[group_pair.pairs.clone()] {
+                let link = placed.get(pair.link, &self.links, &frames);
+                let other = placed.get(pair.other, &self.links, &frames);
+                let moved = if pair.distal == pair.link { &link } else { &other };
+                let loose = loose(&pair.levers);
+                if link.gap_bound(&other) - offset < loose.threshold(best) {
+                    let slack = link.distance(&other) - offset;
+                    if loose.reach(slack) < best {
+                        let exact = exact(moved, &pair.levers, pair.joints.clone());
+                        best = best.min(exact.reach(slack));
+                        if best < least {
+                            return best;
+                        }
+                    }
                 }
             }
         }
         best
     }
+}
+
+/// The first [`Placed::CAPACITY`] capsules placed at most once per query, on the stack; the
+/// others (a model of more) placed at each use.
+struct Placed {
+    slots: [Option<Posed>; Self::CAPACITY],
+}
+
+impl Placed {
+    const CAPACITY: usize = 64;
+
+    fn new() -> Self {
+        Self { slots: std::array::from_fn(|_| None) }
+    }
+
+    fn get(&mut self, i: usize, links: &[LinkCapsule], frames: &[Frame; DOF + 1]) -> Posed {
+        match self.slots.get_mut(i) {
+            Some(slot) => *slot.get_or_insert_with(|| links[i].posed(frames)),
+            None => links[i].posed(frames),
+        }
+    }
+}
+
+/// {b} from a parry pose's axes.
+fn rotation_of(pose: &Pose) -> Matrix3 {
+    let r = pose.rotation;
+    Matrix3::from_columns(&[
+        from_parry(r * Vector::X),
+        from_parry(r * Vector::Y),
+        from_parry(r * Vector::Z),
+    ])
 }
 
 /// A bound on how far the points of a capsule (or of one capsule relative to another) move
@@ -360,93 +597,8 @@ fn levers(robot: &Robot, frame: usize, a: &Vector3, b: &Vector3) -> JointVector 
     })
 }
 
-/// Forward kinematics of the moving frames up to the last carrying a capsule, in aligned
-/// frames: each frame k+1 turned so that the axis of joint k is its z, which makes a joint's
-/// turn a two-column update and folds the joint axes into constant transforms.
-///
-/// With F the moving frames of [`crate::kinematics::arm_pose`] and A_k a rotation taking z onto
-/// joint k's axis u_k: R(u_k, q) A_k = A_k Rz(q), so the aligned frame G_{k+1} = F_{k+1} A_k is
-/// G_k (A_{k−1}ᵀ P_k A_k) Rz(q_k), P_k being the joint's parent-from-joint transform.
-#[derive(Debug, Clone)]
-struct Chain {
-    /// A_{k−1}ᵀ P_k A_k per joint, up to the last frame needed.
-    steps: Vec<Frame>,
-    /// A_{k−1}ᵀ per frame k (the identity for {b}).
-    aligned_from_frame: [Matrix3; DOF + 1],
-}
-
-/// A rigid transform: rotation then translation.
-#[derive(Debug, Clone, Copy)]
-struct Frame {
-    rotation: Matrix3,
-    translation: Vector3,
-}
-
-impl Frame {
-    fn identity() -> Self {
-        Self { rotation: Matrix3::identity(), translation: Vector3::zeros() }
-    }
-
-    fn apply(&self, p: &Vector3) -> Vector3 {
-        self.rotation * p + self.translation
-    }
-}
-
-impl Chain {
-    fn new(robot: &Robot, last: usize) -> Self {
-        let z = Vector3::z();
-        let align: Vec<Matrix3> = robot
-            .joints
-            .iter()
-            .map(|j| {
-                Rotation3::rotation_between(&z, &j.axis)
-                    // The axis is -z: half a turn about x.
-                    .unwrap_or_else(|| Rotation3::from_axis_angle(&Vector3::x_axis(), PI))
-                    .into_inner()
-            })
-            .collect();
-        let mut aligned_from_frame = [Matrix3::identity(); DOF + 1];
-        for k in 1..=DOF {
-            aligned_from_frame[k] = align[k - 1].transpose();
-        }
-        let steps = robot.joints[..last]
-            .iter()
-            .enumerate()
-            .map(|(k, joint)| {
-                let p = &joint.parent_from_joint;
-                let before = aligned_from_frame[k];
-                Frame {
-                    rotation: before * p.rotation.matrix() * align[k],
-                    translation: before * p.translation.vector,
-                }
-            })
-            .collect();
-        Self { steps, aligned_from_frame }
-    }
-
-    /// The aligned frames at `q`, `b_from_aligned`; those past the last needed are left at
-    /// the identity.
-    fn frames(&self, q: &JointVector) -> [Frame; DOF + 1] {
-        let mut frames = [Frame::identity(); DOF + 1];
-        for (k, step) in self.steps.iter().enumerate() {
-            let parent = frames[k];
-            let m = parent.rotation * step.rotation;
-            let (s, c) = q[k].sin_cos();
-            let (x, y) = (m.column(0), m.column(1));
-            frames[k + 1] = Frame {
-                rotation: Matrix3::from_columns(&[
-                    x * c + y * s,
-                    y * c - x * s,
-                    m.column(2).into(),
-                ]),
-                translation: parent.translation + parent.rotation * step.translation,
-            };
-        }
-        frames
-    }
-}
-
 /// A capsule placed in {b}, with its bounding sphere.
+#[derive(Debug, Clone, Copy)]
 struct Posed {
     a: Vector3,
     b: Vector3,
@@ -513,42 +665,6 @@ impl Posed {
         // Every pair of shapes here is supported by parry's default dispatcher.
         contact.ok().flatten().map(|c| c.dist)
     }
-}
-
-/// Distance between the segments p1–q1 and p2–q2 (Ericson, Real-Time Collision Detection
-/// §5.1.9).
-fn segment_segment_distance(p1: &Vector3, q1: &Vector3, p2: &Vector3, q2: &Vector3) -> Real {
-    let (d1, d2, r) = (q1 - p1, q2 - p2, p1 - p2);
-    let (a, e, f) = (d1.norm_squared(), d2.norm_squared(), d2.dot(&r));
-    let tiny = Real::MIN_POSITIVE;
-    let (s, t) = if a <= tiny && e <= tiny {
-        (0.0, 0.0)
-    } else if a <= tiny {
-        (0.0, (f / e).clamp(0.0, 1.0))
-    } else {
-        let c = d1.dot(&r);
-        if e <= tiny {
-            ((-c / a).clamp(0.0, 1.0), 0.0)
-        } else {
-            let b = d1.dot(&d2);
-            let denominator = a * e - b * b;
-            // Parallel segments: any s works; start from p1.
-            let s = if denominator > 0.0 {
-                ((b * f - c * e) / denominator).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let t = (b * s + f) / e;
-            if t < 0.0 {
-                ((-c / a).clamp(0.0, 1.0), 0.0)
-            } else if t > 1.0 {
-                (((b - c) / a).clamp(0.0, 1.0), 1.0)
-            } else {
-                (s, t)
-            }
-        }
-    };
-    ((p1 + d1 * s) - (p2 + d2 * t)).norm()
 }
 
 #[cfg(test)]

@@ -59,6 +59,9 @@ pub struct GeometryOptions {
     /// usable geometry uncovered, which `a2ml robot` reports and planning
     /// with obstacles refuses.
     pub skeleton_radius: Option<Real>,
+    /// The SRDF whose `<disable_collisions>` pairs are not checked; a file beside the URDF
+    /// with its name and the extension `.srdf` when none is given.
+    pub srdf: Option<PathBuf>,
 }
 
 impl Default for GeometryOptions {
@@ -67,6 +70,7 @@ impl Default for GeometryOptions {
             package_path: Vec::new(),
             urdf_dir: None,
             skeleton_radius: Some(DEFAULT_SKELETON_RADIUS),
+            srdf: None,
         }
     }
 }

@@ -274,6 +274,7 @@ pub(super) fn build(
                 package_path: Vec::new(),
                 urdf_dir: None,
                 skeleton_radius: None,
+                srdf: None,
             },
             ..options.clone()
         };
@@ -358,6 +359,11 @@ pub(super) fn build(
         capsules::build(urdf, &links, &skeleton, &options.geometry)?;
 
     let joints: [Joint; DOF] = joints.try_into().map_err(|_| tree.not_seven(&base, &path))?;
+    let allowed_pairs = match &options.geometry.srdf {
+        Some(path) => super::self_pairs::read_srdf(path, urdf)?,
+        None => Vec::new(),
+    };
+    let self_pairs = super::self_pairs::build(&joints, &capsules, &allowed_pairs);
     Ok(Robot {
         name: urdf.name.clone(),
         base_link: base,
@@ -365,6 +371,8 @@ pub(super) fn build(
         joints,
         links,
         capsules,
+        self_pairs,
+        allowed_pairs,
         b_from_base_link,
         frame7_from_hand,
         vertical,

@@ -25,6 +25,20 @@ pub enum RobotError {
         /// The parser's message.
         message: String,
     },
+    /// The SRDF beside the URDF is malformed or names a link the URDF does not have.
+    #[error(
+        "{}{}invalid SRDF: {message}",
+        path.as_deref().map(|p| format!("{p}: ")).unwrap_or_default(),
+        line.map(|l| format!("line {l}: ")).unwrap_or_default()
+    )]
+    Srdf {
+        /// The SRDF file, when read from one.
+        path: Option<String>,
+        /// The line of the element at fault, when one is.
+        line: Option<u32>,
+        /// What is wrong.
+        message: String,
+    },
     /// A link named by the user is not in the URDF.
     #[error("no link named `{name}`{}", did_you_mean.as_deref().map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default())]
     UnknownLink {
@@ -141,6 +155,16 @@ impl RobotError {
         match self {
             Self::Urdf { path: None, message } => {
                 Self::Urdf { path: Some(path.display().to_string()), message }
+            }
+            other => other,
+        }
+    }
+
+    /// Adds the SRDF file's path to errors that came from parsing its text.
+    pub(crate) fn in_srdf(self, srdf: &std::path::Path) -> Self {
+        match self {
+            Self::Srdf { path: None, line, message } => {
+                Self::Srdf { path: Some(srdf.display().to_string()), line, message }
             }
             other => other,
         }

@@ -10,11 +10,14 @@ mod acceleration;
 mod capsules;
 mod chain;
 mod error;
+mod self_pairs;
+mod srdf;
 mod structure;
 mod urdf;
 
 pub use capsules::{CapsuleSource, DEFAULT_SKELETON_RADIUS, GeometryOptions};
 pub use error::RobotError;
+pub use self_pairs::{SELF_CONTACT_MARGIN, home};
 pub use structure::{ArmStructure, least_squares_point, line_distance};
 
 pub use acceleration::{ATTRIBUTE as ACCELERATION_ATTRIBUTE, DEFAULT_ACCELERATION_PER_SECOND};
@@ -184,6 +187,12 @@ pub struct Robot {
     pub links: Vec<ChainLink>,
     /// Collision capsules of the chain's links.
     pub capsules: Vec<Capsule>,
+    /// The capsule pairs checked against each other (indices into `capsules`, the one
+    /// farther along the chain first): those with a body carrying geometry between them, not
+    /// within [`SELF_CONTACT_MARGIN`] at [`home`], and not disabled by the SRDF.
+    pub self_pairs: Vec<(usize, usize)>,
+    /// The link pairs the SRDF disables (`<disable_collisions>`), in its order.
+    pub allowed_pairs: Vec<(String, String)>,
     /// Pose of the base link in {b} (a pure translation by -S).
     pub b_from_base_link: Isometry,
     /// Frame 7 to the hand frame {W}'s orientation: columns f, p, f × p.
@@ -229,6 +238,10 @@ impl Robot {
         let mut options = options.clone();
         if options.geometry.urdf_dir.is_none() {
             options.geometry.urdf_dir = path.parent().map(std::path::Path::to_path_buf);
+        }
+        if options.geometry.srdf.is_none() {
+            let beside = path.with_extension("srdf");
+            options.geometry.srdf = beside.is_file().then_some(beside);
         }
         Self::from_urdf_str(&text, &options).map_err(|e| e.in_file(path))
     }

@@ -23,7 +23,7 @@ use super::monitor::Monitor;
 pub use super::timing::{LIMIT_FRACTION, TimedPath, shortest_bell, time_parameterise};
 use super::tree::{Tree, TreeSpace, connect_trees};
 use crate::collision::{
-    CollisionModel, CollisionScene, advancement_at_least, clearance, min_distance, motion_bound,
+    CollisionModel, CollisionScene, advancement_within, clearance, min_distance, motion_bound,
 };
 use crate::kinematics::arm_pose;
 use crate::math::{JointVector, Real};
@@ -288,11 +288,17 @@ impl<'a> JointSpace<'a> {
         Some(format!("{:.1} mm from `{obstacle}` (link `{link}`)", d * 1e3))
     }
 
-    /// How far (in units of `dq`) the arm at `q` may move along `dq`, either way, keeping the
-    /// clearance, if at least `least`.
-    fn advancement(&mut self, q: &JointVector, dq: &JointVector, least: Real) -> Option<Real> {
+    /// How far (in units of `dq`, up to `enough`) the arm at `q` may move along `dq`, either
+    /// way, keeping the clearance, if at least `least`.
+    fn advancement(
+        &mut self,
+        q: &JointVector,
+        dq: &JointVector,
+        least: Real,
+        enough: Real,
+    ) -> Option<Real> {
         self.checks += 1;
-        advancement_at_least(&self.model, q, dq, self.options.clearance, least)
+        advancement_within(&self.model, q, dq, self.options.clearance, least, enough)
     }
 
     /// Whether the straight edge a -> b keeps the clearance, `b` being a new configuration
@@ -314,10 +320,10 @@ impl<'a> JointSpace<'a> {
         }
         // Half the resolution of arm motion, in units of the edge.
         let floor = 0.5 * self.options.resolution / travel;
-        let Some(at_b) = self.advancement(b, &dq, if new { floor } else { 0.0 }) else {
+        let Some(at_b) = self.advancement(b, &dq, if new { floor } else { 0.0 }, 1.0) else {
             return false;
         };
-        let Some(at_a) = self.advancement(a, &dq, 0.0) else {
+        let Some(at_a) = self.advancement(a, &dq, 0.0, 1.0) else {
             return false;
         };
         // Next to a tight end, stretches are split until covered, down to this.
@@ -336,7 +342,8 @@ impl<'a> JointSpace<'a> {
             let (middle, half) = (0.5 * (gap.from + gap.to), 0.5 * (gap.to - gap.from));
             // Enough to close the stretch, or to split it.
             let splits = if (gap.tight_a || gap.tight_b) && half > finest { 0.0 } else { floor };
-            let Some(covered) = self.advancement(&(a + dq * middle), &dq, half.min(splits)) else {
+            let Some(covered) = self.advancement(&(a + dq * middle), &dq, half.min(splits), half)
+            else {
                 return false;
             };
             if covered >= half {

@@ -50,6 +50,8 @@ from a2ml._a2ml import (
     parse,
     plan,
     plan_many,
+    rrt_connect,
+    scene_clearance,
     swivel_map,
 )
 from a2ml._types import (
@@ -94,5 +96,7 @@ __all__ = [
     "parse",
     "plan",
     "plan_many",
+    "rrt_connect",
+    "scene_clearance",
     "swivel_map",
 ]

@@ -871,6 +871,30 @@ def compare(
     """
 
 
+def rrt_connect(
+    robot: Robot,
+    obstacles: Iterable[dict[str, Any]],
+    start: ArrayLike,
+    goals: Iterable[ArrayLike],
+    *,
+    seed: int = 0,
+    clearance: float = 0.01,
+    max_samples: int = 20000,
+    step: float = 2.0,
+    resolution: float = 0.005,
+    shortcuts: int = 200,
+) -> dict[str, Any]:
+    """Joint-space RRT-Connect among obstacle dicts in the URDF root frame.
+
+    Each obstacle: ``type`` (box, sphere, cylinder), ``position``, optional
+    ``orientation_quat_xyzw``, and ``half_extents``, ``radius``, ``length``.
+    Returns ``waypoints`` ((N, 7) array), ``goal``, ``samples``, ``nodes``,
+    ``collision_checks``; raises PlanError when no path is found.
+    """
+
+def scene_clearance(robot: Robot, obstacles: Iterable[dict[str, Any]], q: ArrayLike) -> float:
+    """Smallest signed distance (m) of the arm at q to the obstacles or between its self pairs."""
+
 def swivel_map(
     task_or_robot: Task | Robot | str | os.PathLike[str],
     action: str | None = None,

@@ -59,8 +59,9 @@ fn capsules_move_within_their_motion_bounds() {
         let (lower, upper) = (robot.lower(), robot.upper());
         // (capsule, the frame it is seen from, its levers, the joints between)
         let mut cases: Vec<(usize, usize, JointVector, std::ops::Range<usize>)> = model
-            .moving
+            .groups
             .iter()
+            .flat_map(|g| g.members.iter())
             .map(|&i| (i, 0, model.links[i].levers, 0..model.links[i].frame))
             .collect();
         for pair in &model.self_pairs {
@@ -102,5 +103,49 @@ fn capsules_move_within_their_motion_bounds() {
             }
         }
         assert!(tightest > 0.8, "{name}: the bound is never approached: {tightest}");
+    }
+}
+
+/// The closed forms for a point against a turned box or cylinder give parry's signed distance,
+/// outside and inside.
+#[test]
+fn point_distances_to_solids_match_parry() {
+    use crate::language::{Obstacle, Shape};
+    let path = format!("{}/../../robots/panda.urdf", env!("CARGO_MANIFEST_DIR"));
+    let robot = Robot::from_urdf_file(path).expect("robot loads");
+    let mut rng = rand::rngs::StdRng::seed_from_u64(17);
+    let mut number = |lo: Real, hi: Real| rng.random_range(lo..hi);
+    for k in 0..2000 {
+        let center = v(number(-1.0, 1.0), number(-1.0, 1.0), number(-1.0, 1.0));
+        let rotation =
+            Rotation3::from_euler_angles(number(-PI, PI), number(-PI, PI), number(-PI, PI));
+        let shape = if k % 2 == 0 {
+            let size = v(number(0.05, 0.8), number(0.05, 0.8), number(0.05, 0.8));
+            Shape::Box { center, size, rotation }
+        } else {
+            Shape::Cylinder {
+                center,
+                radius: number(0.02, 0.4),
+                height: number(0.05, 0.8),
+                rotation,
+            }
+        };
+        let scene = CollisionScene::new(&[Obstacle { name: "solid".into(), shape }]);
+        let model = CollisionModel::new(&robot, &scene);
+        let convex = &model.convex[0];
+        let p = center + v(number(-0.6, 0.6), number(-0.6, 0.6), number(-0.6, 0.6));
+        let point = parry3d_f64::shape::Ball::new(1e-300);
+        let expected = query::contact(
+            &convex.body.pose,
+            convex.body.shape.as_dyn(),
+            &Pose::from_translation(to_parry(&p)),
+            &point,
+            10.0,
+        )
+        .expect("supported")
+        .expect("within the prediction")
+        .dist;
+        let found = convex.point_distance(&p);
+        assert!((found - expected).abs() < 1e-7, "{k}: {found} vs {expected}");
     }
 }
