@@ -380,12 +380,19 @@ impl PyRobot {
                 let near = near_values
                     .map(|v| JointVector::from_column_slice(&v[DOF * i..DOF * i + DOF]))
                     .or(near_one);
-                match kinematics::ik_cpsa(&self.robot, &target, near.as_ref()) {
-                    // The core returns at least one solution or an error; nearest first.
-                    Ok(solutions) if !solutions.is_empty() => {
-                        q.copy_from_slice(solutions[0].as_slice())
-                    }
-                    Ok(_) => q.fill(Real::NAN),
+                // The nearest solution alone: ik_cpsa's first, without the others. Without a
+                // q_near, ik_cpsa itself: a numerical arm then tries its guesses first.
+                let solved = match near {
+                    Some(near) => kinematics::ik_cpsa_nearest(&self.robot, &target, &near),
+                    None => kinematics::ik_cpsa(&self.robot, &target, None).and_then(|s| {
+                        s.into_iter().next().ok_or(KinematicsError::NoConvergence {
+                            residual: Real::INFINITY,
+                            starts: 0,
+                        })
+                    }),
+                };
+                match solved {
+                    Ok(solution) => q.copy_from_slice(solution.as_slice()),
                     Err(e) if on_error == OnError::Raise => return Some((i, e)),
                     Err(_) => q.fill(Real::NAN),
                 }
