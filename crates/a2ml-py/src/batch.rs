@@ -10,7 +10,7 @@
 use a2ml_core::kinematics::{self, ArmPose, CpsaState, KinematicsError};
 use a2ml_core::math::{DOF, Jacobian6x7, JointVector, Matrix3, Real, Vector3};
 use numpy::{
-    AllowTypeChange, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyReadwriteArrayDyn,
+    AllowTypeChange, IntoPyArray, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyReadwriteArrayDyn,
     PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -152,15 +152,34 @@ fn write_jacobian(out: &mut [Real], j: &Jacobian6x7) {
     }
 }
 
+/// `values` (row-major, of `shape`) written into the caller's `out`, or as a new array: made
+/// from the values directly, which costs less than a zeroed array borrowed for writing.
+fn emit<'py>(
+    py: Python<'py>,
+    out: Option<&Bound<'py, PyAny>>,
+    name: &str,
+    shape: &[usize],
+    values: &[Real],
+) -> PyResult<Array<'py>> {
+    if out.is_none() {
+        let array = numpy::ndarray::ArrayD::from_shape_vec(shape, values.to_vec())
+            .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))?;
+        return Ok(array.into_pyarray(py));
+    }
+    let array = output(py, out, name, shape)?;
+    slots(&mut writer(&array, name)?).copy_from_slice(values);
+    Ok(array)
+}
+
 /// The hand frame {W} of `pose` (4x4), written into `out` when given.
 pub(crate) fn frame_into<'py>(
     py: Python<'py>,
     pose: &ArmPose,
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Array<'py>> {
-    let frame = output(py, out, "out", &[4, 4])?;
-    write_frame(slots(&mut writer(&frame, "out")?), pose);
-    Ok(frame)
+    let mut values = [0.0; FRAME];
+    write_frame(&mut values, pose);
+    emit(py, out, "out", &[4, 4], &values)
 }
 
 /// J_ge (6x7), written into `out` when given.
@@ -169,9 +188,9 @@ pub(crate) fn jacobian_into<'py>(
     j: &Jacobian6x7,
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Array<'py>> {
-    let jacobian = output(py, out, "out", &[6, DOF])?;
-    write_jacobian(slots(&mut writer(&jacobian, "out")?), j);
-    Ok(jacobian)
+    let mut values = [0.0; JACOBIAN];
+    write_jacobian(&mut values, j);
+    emit(py, out, "out", &[6, DOF], &values)
 }
 
 /// A core error of row `row`, as the exception the per-call method raises, its message led
@@ -216,12 +235,13 @@ impl PyRobot {
         jacobian_out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<(Array<'py>, Array<'py>)> {
         let pose = kinematics::arm_pose(&self.robot, &read_joints(q, "q")?);
-        let frame = output(py, frame_out, "frame_out", &[4, 4])?;
-        let jacobian = output(py, jacobian_out, "jacobian_out", &[6, DOF])?;
-        write_frame(slots(&mut writer(&frame, "frame_out")?), &pose);
-        let j = kinematics::geometric_jacobian(&pose);
-        write_jacobian(slots(&mut writer(&jacobian, "jacobian_out")?), &j);
-        Ok((frame, jacobian))
+        let (mut frame, mut jacobian) = ([0.0; FRAME], [0.0; JACOBIAN]);
+        write_frame(&mut frame, &pose);
+        write_jacobian(&mut jacobian, &kinematics::geometric_jacobian(&pose));
+        Ok((
+            emit(py, frame_out, "frame_out", &[4, 4], &frame)?,
+            emit(py, jacobian_out, "jacobian_out", &[6, DOF], &jacobian)?,
+        ))
     }
 
     /// The hand frame {W} at each row of `q` (N, 7), as (N, 4, 4).
