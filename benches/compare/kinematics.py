@@ -235,7 +235,7 @@ def main() -> None:
             ik = measure({"ik": ik_problem(robot, batch)}, max(3, args.rounds // 3), args.batch)
             batched, looped, ratio = ik["ik"]
             print(
-                f"| {name} | ik_cpsa_many (all branches, nearest kept) vs ik_cpsa loop (a2ml) | "
+                f"| {name} | ik_cpsa_many (nearest solution) vs ik_cpsa loop (a2ml) | "
                 f"{microseconds(batched)} | {microseconds(looped)} (a2ml loop) | {ratio:.3f} |"
             )
 
