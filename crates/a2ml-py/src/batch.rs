@@ -79,7 +79,7 @@ fn read_rows<'py>(value: &Bound<'py, PyAny>, name: &str, row: &[usize]) -> PyRes
     let rows = Rows { array: like, copied, count };
     let size: usize = row.iter().product();
     if let Some(bad) = rows.values().iter().position(|v| !v.is_finite()) {
-        let at = if size == 0 { 0 } else { bad / size };
+        let at = bad.checked_div(size).unwrap_or(0);
         return Err(PyValueError::new_err(format!("{name}[{at}] contains NaN or infinity")));
     }
     Ok(rows)
