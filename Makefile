@@ -15,7 +15,7 @@ WHEEL_DIR := $(CARGO_TARGET_DIR)/wheels
 # The wheel is rebuilt when anything it is built from changes.
 PY_INPUTS := $(shell find crates/a2ml-core crates/a2ml-py -type f -not -name '*.pyc') Cargo.toml Cargo.lock
 
-.PHONY: test rust-test py-test python build clean
+.PHONY: test rust-test py-test python build clean compare
 
 test: rust-test py-test
 
@@ -49,6 +49,28 @@ py-test: python
 build:
 	$(CARGO) build --release -p a2ml-cli
 
+# Side by side with the peers users would pick instead (benches/compare/README.md): the
+# peers and a release wheel of a2ml go into a venv of their own, never into .venv, and
+# `make test` never runs them. Each script prints its table.
+COMPARE_VENV    := .venv-compare
+COMPARE_PY      := $(COMPARE_VENV)/bin/python
+COMPARE_REQS    := benches/compare/requirements.txt
+COMPARE_SCRIPTS := $(wildcard benches/compare/kinematics.py benches/compare/rrt.py)
+
+$(COMPARE_VENV)/.tools-installed: $(COMPARE_REQS)
+	$(PYTHON) -m venv $(COMPARE_VENV)
+	$(COMPARE_PY) -m pip install --quiet --disable-pip-version-check -r $(COMPARE_REQS)
+	touch $@
+
+$(COMPARE_VENV)/.wheel-installed: $(COMPARE_VENV)/.tools-installed $(PY_INPUTS)
+	rm -f $(WHEEL_DIR)/a2ml-*.whl
+	$(COMPARE_VENV)/bin/maturin build --release --manifest-path $(PY_CRATE)/Cargo.toml --interpreter $(COMPARE_PY) --out $(WHEEL_DIR)
+	$(COMPARE_PY) -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps $(WHEEL_DIR)/a2ml-*.whl
+	touch $@
+
+compare: $(COMPARE_VENV)/.wheel-installed
+	for script in $(COMPARE_SCRIPTS); do $(COMPARE_PY) $$script || exit 1; done
+
 clean:
 	$(CARGO) clean
-	rm -rf $(VENV)
+	rm -rf $(VENV) $(COMPARE_VENV)

@@ -1,12 +1,12 @@
 //! Hot paths of the kinematics: FK + J_ge, CPSA state + J_cs, analytic IK
-//! (all branches), closed-form swivel intervals.
+//! (all branches, and the nearest only), closed-form swivel intervals.
 
 use std::hint::black_box;
 
 use a2ml::Robot;
 use a2ml::kinematics::{
     arm_pose, cpsa_jacobian, cpsa_state, geometric_jacobian, hat_jacobian, hat_state, ik_cpsa,
-    swivel_intervals,
+    ik_cpsa_nearest, swivel_intervals,
 };
 use a2ml::math::JointVector;
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -49,6 +49,11 @@ fn kinematics(c: &mut Criterion) {
         });
         let ik_name = if robot.has_analytic_ik() { "ik_cpsa_analytic" } else { "ik_cpsa_newton" };
         group.bench_function(ik_name, |b| b.iter(|| ik_cpsa(&robot, black_box(&cpsa), Some(&q))));
+        // What tracking a branch asks for: the nearest solution only, `near` close by.
+        let near = q.map(|v| v + 1e-3);
+        group.bench_function("ik_cpsa_nearest", |b| {
+            b.iter(|| ik_cpsa_nearest(&robot, black_box(&cpsa), &near))
+        });
         if robot.has_analytic_ik() {
             group.bench_function("swivel_intervals", |b| {
                 b.iter(|| swivel_intervals(&robot, black_box(&cpsa.pw), &cpsa.ow))

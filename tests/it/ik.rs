@@ -89,6 +89,34 @@ fn nearest_branch_comes_first() {
     }
 }
 
+/// The nearest-only solvers give exactly the first of the full solvers' solutions, or their
+/// error: near the configuration (tracking), far from it (another branch nearest), and at
+/// random `near`s and targets, on every arm.
+#[test]
+fn nearest_only_ik_equals_the_first_solution() {
+    for (name, robot) in all_robots() {
+        let mut rng = rng(14);
+        let samples = if robot.has_analytic_ik() { 2000 } else { 20 };
+        for k in 0..samples {
+            let (q, pose) = regular_q(&robot, &mut rng, 0.1);
+            let near = match k % 3 {
+                0 => q.map(|v| v + 1e-3),
+                1 => crate::common::random_q(&robot, &mut rng),
+                _ => robot.middle(),
+            };
+            let mut cpsa = cpsa_state(&robot, &pose).expect("regular");
+            if k % 7 == 0 {
+                cpsa.pw *= 1.3; // often out of reach: the errors must agree too
+            }
+            let full = ik_cpsa(&robot, &cpsa, Some(&near)).map(|s| s[0]);
+            assert_eq!(ik_cpsa_nearest(&robot, &cpsa, &near), full, "{name}: CPSA at {q:?}");
+            let hat = hat_state(&pose).expect("regular");
+            let full = ik_hat(&robot, &hat, Some(&near)).map(|s| s[0]);
+            assert_eq!(ik_hat_nearest(&robot, &hat, &near), full, "{name}: HAT at {q:?}");
+        }
+    }
+}
+
 #[test]
 fn mapping_round_trips() {
     for (name, robot) in all_robots() {

@@ -4,7 +4,8 @@
 use a2ml_core::math::{DOF, JointVector, Matrix3, Real, Rotation3, Vector3};
 use numpy::ndarray::Array2;
 use numpy::{
-    AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLikeDyn, PyUntypedArrayMethods,
+    AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLikeDyn, PyArrayMethods,
+    PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -18,7 +19,7 @@ pub(crate) type Matrix<'py> = Bound<'py, PyArray2<Real>>;
 const ROTATION_TOL: Real = 1e-6;
 
 /// `(7,)` or `(3, 3)`, as numpy prints shapes.
-fn shape_text(shape: &[usize]) -> String {
+pub(crate) fn shape_text(shape: &[usize]) -> String {
     match shape {
         [n] => format!("({n},)"),
         _ => format!("({})", shape.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(", ")),
@@ -57,7 +58,18 @@ pub(crate) fn read_array(
     Ok(values)
 }
 
+/// Joints from a (7,) array-like. A float64 numpy vector, what callers in a loop pass, is
+/// read element by element in place: no conversion, no copy, no borrow to register.
 pub(crate) fn read_joints(value: &Bound<'_, PyAny>, name: &str) -> PyResult<JointVector> {
+    if let Ok(array) = value.cast::<PyArray1<Real>>() {
+        if array.len() == DOF {
+            let q = JointVector::from_fn(|i, _| array.get_owned([i]).unwrap_or(Real::NAN));
+            if !q.iter().all(|v| v.is_finite()) {
+                return Err(PyValueError::new_err(format!("{name} contains NaN or infinity")));
+            }
+            return Ok(q);
+        }
+    }
     Ok(JointVector::from_row_slice(&read_array(value, name, &[DOF])?))
 }
 
@@ -66,7 +78,11 @@ pub(crate) fn read_vector3(value: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec
 }
 
 pub(crate) fn read_rotation(value: &Bound<'_, PyAny>, name: &str) -> PyResult<Rotation3> {
-    let m = Matrix3::from_row_slice(&read_array(value, name, &[3, 3])?);
+    rotation_from(Matrix3::from_row_slice(&read_array(value, name, &[3, 3])?), name)
+}
+
+/// `m` as a rotation if it is orthonormal (to `ROTATION_TOL`) with determinant +1.
+pub(crate) fn rotation_from(m: Matrix3, name: &str) -> PyResult<Rotation3> {
     let error = (m.transpose() * m - Matrix3::identity()).amax();
     if error > ROTATION_TOL {
         return Err(PyValueError::new_err(format!(

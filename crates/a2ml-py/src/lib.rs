@@ -7,6 +7,7 @@
 //! mapping in [`errors`], numpy conversions in [`convert`], the robot in
 //! [`robot`]; this file registers the module.
 
+mod batch;
 mod compare;
 mod convert;
 mod decompose;

@@ -8,6 +8,7 @@ use a2ml_core::robot::RobotOptions;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple, PyType};
 
+use crate::batch;
 use crate::convert::{
     Matrix, Vector, read_angle, read_joints, read_rotation, read_vector3, to_matrix, to_rotation,
     to_solutions, to_vector,
@@ -169,9 +170,14 @@ impl PyRobot {
     }
 
     /// The hand frame {W} in {b} as a 4x4 homogeneous matrix.
-    fn fk<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Matrix<'py>> {
-        let frame = self.pose(q)?.hand_frame().to_homogeneous();
-        Ok(to_matrix(py, &frame, 4, 4))
+    #[pyo3(signature = (q, out=None))]
+    fn fk<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<batch::Array<'py>> {
+        batch::frame_into(py, &self.pose(q)?, out)
     }
 
     /// Shoulder, elbow and wrist centres in {b}.
@@ -185,9 +191,14 @@ impl PyRobot {
     }
 
     /// J_ge (6x7): linear velocity of W, angular velocity of the hand.
-    fn jacobian<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Matrix<'py>> {
-        let j = kinematics::geometric_jacobian(&self.pose(q)?);
-        Ok(to_matrix(py, &j, 6, DOF))
+    #[pyo3(signature = (q, out=None))]
+    fn jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<batch::Array<'py>> {
+        batch::jacobian_into(py, &kinematics::geometric_jacobian(&self.pose(q)?), out)
     }
 
     /// The CPSA state (pw, ow, swivel).

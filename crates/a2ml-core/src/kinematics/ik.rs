@@ -396,29 +396,149 @@ fn branches_with_wrist(
     ow: &Rotation3,
     near: &JointVector,
 ) -> Result<Vec<JointVector>, KinematicsError> {
-    let w = &s.axes_zero;
     let mut out = Vec::with_capacity(8);
     for (q4, r123) in placements_of(s, wrist_zero, elbow, wrist)? {
-        // Whatever the shoulder branch, R1 R2 R3 = r123: the wrist's share of
-        // Ow is the same for both, so it is split once per q4.
-        let r567 = (r123 * rotation_about(&w[3], q4)).transpose()
-            * ow.matrix()
-            * s.hand_zero.matrix().transpose();
-        let wrists = decompose(&r567, &w[4], &w[5], &w[6], near[4])?;
-        for &[q1, q2, q3] in decompose(&r123, &w[0], &w[1], &w[2], near[0])?.as_slice() {
-            for [q5, q6, q7] in wrists.as_slice() {
-                let q = JointVector::from_column_slice(&[q1, q2, q3, q4, *q5, *q6, *q7]);
-                push_shifts(robot, q, &mut out);
+        elbow_branches(robot, s, q4, &r123, ow, near, &mut out)?;
+    }
+    Ok(out)
+}
+
+/// Pushes the branches of one elbow angle q4 (shoulder rotation `r123`) onto `out`.
+fn elbow_branches(
+    robot: &Robot,
+    s: &ArmStructure,
+    q4: Real,
+    r123: &Matrix3,
+    ow: &Rotation3,
+    near: &JointVector,
+    out: &mut Vec<JointVector>,
+) -> Result<(), KinematicsError> {
+    let w = &s.axes_zero;
+    // Whatever the shoulder branch, R1 R2 R3 = r123: the wrist's share of
+    // Ow is the same for both, so it is split once per q4.
+    let r567 = (r123 * rotation_about(&w[3], q4)).transpose()
+        * ow.matrix()
+        * s.hand_zero.matrix().transpose();
+    let wrists = decompose(&r567, &w[4], &w[5], &w[6], near[4])?;
+    for &[q1, q2, q3] in decompose(r123, &w[0], &w[1], &w[2], near[0])?.as_slice() {
+        for [q5, q6, q7] in wrists.as_slice() {
+            let q = JointVector::from_column_slice(&[q1, q2, q3, q4, *q5, *q6, *q7]);
+            push_shifts(robot, q, out);
+        }
+    }
+    Ok(())
+}
+
+/// The first of [`ik_cpsa`]'s solutions (the in-limit branch nearest `near`) without the
+/// others: what tracking an IK branch along a path asks for, many times per edge.
+///
+/// # Errors
+/// As [`ik_cpsa`].
+pub fn ik_cpsa_nearest(
+    robot: &Robot,
+    target: &CpsaState,
+    near: &JointVector,
+) -> Result<JointVector, KinematicsError> {
+    if !(target.pw.iter().all(|v| v.is_finite()) && target.swivel.is_finite()) {
+        return Err(KinematicsError::NonFinite { what: "CPSA state" });
+    }
+    if robot.has_analytic_ik() && robot.structure.idealisation <= 1e-9 {
+        let hat = cpsa_to_hat(robot, target)?;
+        let (elbow, wrist) = hat_points(robot, &hat);
+        if let Some(q) = nearest_branch(robot, &elbow, &wrist, &target.ow, near)? {
+            return Ok(q);
+        }
+    }
+    first(ik_cpsa(robot, target, Some(near))?)
+}
+
+/// The first of [`ik_hat`]'s solutions; as [`ik_cpsa_nearest`].
+///
+/// # Errors
+/// As [`ik_hat`].
+pub fn ik_hat_nearest(
+    robot: &Robot,
+    target: &HatState,
+    near: &JointVector,
+) -> Result<JointVector, KinematicsError> {
+    let finite = target.elbow_angle.is_finite()
+        && target.shoulder_frame.matrix().iter().all(|v| v.is_finite());
+    if finite && robot.has_analytic_ik() && robot.structure.idealisation <= 1e-9 {
+        let (elbow, wrist) = hat_points(robot, target);
+        if let Some(q) = nearest_branch(robot, &elbow, &wrist, &target.ow, near)? {
+            return Ok(q);
+        }
+    }
+    first(ik_hat(robot, target, Some(near))?)
+}
+
+fn first(solutions: Vec<JointVector>) -> Result<JointVector, KinematicsError> {
+    // The solvers return at least one solution or an error.
+    solutions.into_iter().next().ok_or(KinematicsError::Singular(Singularity::ParallelAxes))
+}
+
+/// The branch `select` would put first, computed elbow angle by elbow angle, nearest q4
+/// first, skipping an elbow angle whose every branch is farther from `near` (in joint 4
+/// alone) than the best found. `None` where that shortcut could differ from `select` (two
+/// elbow angles one turn apart or equal, whose branches it would deduplicate across) or finds
+/// no branch within the limits: the caller then runs the full solve, errors included.
+fn nearest_branch(
+    robot: &Robot,
+    elbow: &Vector3,
+    wrist: &Vector3,
+    ow: &Rotation3,
+    near: &JointVector,
+) -> Result<Option<JointVector>, KinematicsError> {
+    let s = &robot.structure;
+    let placements = placements_of(s, &s.wrist_zero, elbow, wrist)?;
+    // No branch of an elbow angle is nearer than its q4 is to near's (2π shifts included).
+    let bound = |q4: Real| wrap_angle(q4 - near[3]).abs() - 1e-9;
+    let mut order: Vec<usize> = (0..placements.len()).collect();
+    if let [(a, _), (b, _)] = placements[..] {
+        if wrap_angle(a - b).abs() <= 1e-6 {
+            return Ok(None);
+        }
+        if bound(b) < bound(a) {
+            order.swap(0, 1);
+        }
+    }
+    let tolerance = IkOptions::default().limit_tolerance;
+    // (distance, elbow angle's index as `select` meets it, index within it, joints)
+    let mut best: Option<(Real, usize, usize, JointVector)> = None;
+    let mut branches = Vec::with_capacity(8);
+    let mut kept: Vec<JointVector> = Vec::with_capacity(8);
+    for g in order {
+        let (q4, r123) = placements[g];
+        if best.is_some_and(|(d, ..)| bound(q4) > d) {
+            continue;
+        }
+        branches.clear();
+        kept.clear();
+        elbow_branches(robot, s, q4, &r123, ow, near, &mut branches)?;
+        for (k, q) in branches.iter().enumerate() {
+            if !robot.within_limits(q, tolerance) || kept.iter().any(|p| (p - q).amax() < 1e-9) {
+                continue;
+            }
+            kept.push(*q);
+            let d = (q - near).norm();
+            let better = match best {
+                None => true,
+                // A stable sort by distance keeps the earlier of equal ones.
+                Some((bd, bg, bk, _)) => d < bd || (d == bd && (g, k) < (bg, bk)),
+            };
+            if better {
+                best = Some((d, g, k, *q));
             }
         }
     }
-    Ok(out)
+    Ok(best.map(|(.., q)| q))
 }
 
 /// Pushes every version of `q` whose angles are moved by multiples of 2π
 /// into their joint ranges (several where a range spans more than a turn,
 /// as on continuous joints); a joint that no shift brings inside keeps the
 /// shift nearest its range, so that the branch can still be reported.
+/// IK calls this for every branch: it allocates nothing but the pushes.
 fn push_shifts(robot: &Robot, q: JointVector, out: &mut Vec<JointVector>) {
     let first = out.len();
     out.push(q);
@@ -426,26 +546,25 @@ fn push_shifts(robot: &Robot, q: JointVector, out: &mut Vec<JointVector>) {
         let l = &joint.limits;
         let base = q[i] - 2.0 * PI * ((q[i] - l.lower) / (2.0 * PI)).floor();
         // base is the smallest shift at or above the lower limit.
-        let values: Vec<Real> = (0..)
-            .map(|k| base + 2.0 * PI * Real::from(k))
-            .take_while(|v| *v <= l.upper + 1e-9)
-            .collect();
-        let values = if values.is_empty() {
+        let shift = |k: u32| base + 2.0 * PI * Real::from(k);
+        let inside = (0..).take_while(|k| shift(*k) <= l.upper + 1e-9).count() as u32;
+        let count = out.len() - first;
+        if inside == 0 {
             let excess = |v: Real| (l.lower - v).max(v - l.upper).max(0.0);
             let nearest =
                 if excess(base - 2.0 * PI) < excess(base) { base - 2.0 * PI } else { base };
-            vec![nearest]
-        } else {
-            values
-        };
-        let count = out.len() - first;
+            for q in &mut out[first..first + count] {
+                q[i] = nearest;
+            }
+            continue;
+        }
         for k in 0..count {
-            for (n, v) in values.iter().enumerate() {
+            for n in 0..inside {
                 if n == 0 {
-                    out[first + k][i] = *v;
+                    out[first + k][i] = shift(0);
                 } else {
                     let mut shifted = out[first + k];
-                    shifted[i] = *v;
+                    shifted[i] = shift(n);
                     out.push(shifted);
                 }
             }
@@ -475,20 +594,15 @@ fn out_of_limits(robot: &Robot, q: &JointVector) -> KinematicsError {
     }
 }
 
-/// The distinct branches within limits, nearest `near` first.
+/// The distinct branches within limits, nearest `near` first, kept in `branches`' own
+/// storage (IK calls this once per solve).
 fn select(
     robot: &Robot,
-    branches: Vec<JointVector>,
+    mut branches: Vec<JointVector>,
     near: &JointVector,
     tolerance: Real,
 ) -> Result<Vec<JointVector>, KinematicsError> {
-    let mut inside: Vec<JointVector> = Vec::with_capacity(branches.len());
-    for q in branches.iter().filter(|q| robot.within_limits(q, tolerance)) {
-        if !inside.iter().any(|p| (p - q).amax() < 1e-9) {
-            inside.push(*q);
-        }
-    }
-    if inside.is_empty() {
+    if !branches.iter().any(|q| robot.within_limits(q, tolerance)) {
         let least = branches
             .iter()
             .min_by(|a, b| limit_excess(robot, a).1.total_cmp(&limit_excess(robot, b).1));
@@ -497,8 +611,20 @@ fn select(
             None => KinematicsError::Singular(Singularity::ParallelAxes),
         });
     }
-    inside.sort_by(|a, b| (a - near).norm().total_cmp(&(b - near).norm()));
-    Ok(inside)
+    // In place: the first of each set of equal branches within limits stays, in order.
+    let mut kept = 0;
+    for k in 0..branches.len() {
+        let q = branches[k];
+        if robot.within_limits(&q, tolerance)
+            && !branches[..kept].iter().any(|p| (p - q).amax() < 1e-9)
+        {
+            branches[kept] = q;
+            kept += 1;
+        }
+    }
+    branches.truncate(kept);
+    branches.sort_by(|a, b| (a - near).norm().total_cmp(&(b - near).norm()));
+    Ok(branches)
 }
 
 /// The k-th point of a Halton sequence, scaled into the joint limits.

@@ -17,7 +17,9 @@ mod swivel;
 pub use error::{KinematicsError, Singularity};
 pub use fk::{ArmPose, arm_pose, geometric_jacobian, link_poses, point_jacobian};
 pub use frames::{AlignedChain, Frame};
-pub use ik::{IkOptions, ik_cpsa, ik_cpsa_with, ik_hat, ik_hat_with};
+pub use ik::{
+    IkOptions, ik_cpsa, ik_cpsa_nearest, ik_cpsa_with, ik_hat, ik_hat_nearest, ik_hat_with,
+};
 pub use spaces::{
     CpsaState, HatState, cpsa_jacobian, cpsa_state, cpsa_to_hat, hat_jacobian, hat_state,
     hat_to_cpsa, swivel_angle,

@@ -12,7 +12,9 @@ use rand::rngs::StdRng;
 use super::problem::SegmentProblem;
 use super::report::Tolerance;
 use crate::decompose::{ArmState, goal_error};
-use crate::kinematics::{CpsaState, HatState, ik_cpsa, ik_hat, swivel_intervals};
+use crate::kinematics::{
+    CpsaState, HatState, ik_cpsa, ik_cpsa_nearest, ik_hat, ik_hat_nearest, swivel_intervals,
+};
 use crate::language::{Space, Target, Variable};
 use crate::math::{JointVector, PI, Real, Rotation3, rotation_distance, rotation_log, wrap_angle};
 use crate::profile::{Reference, Role};
@@ -269,7 +271,16 @@ impl Chart {
         x: &ChartPoint,
         near: &JointVector,
     ) -> Option<JointVector> {
-        self.ik(robot, x, near).into_iter().next()
+        match (self.space, x.values) {
+            (Space::Cpsa, [Target::Position(pw), Target::Rotation(ow), Target::Angle(swivel)]) => {
+                ik_cpsa_nearest(robot, &CpsaState { pw, ow, swivel }, near).ok()
+            }
+            (Space::Hat, [Target::Rotation(os), Target::Angle(elbow), Target::Rotation(ow)]) => {
+                let hat = HatState { shoulder_frame: os, elbow_angle: elbow, ow };
+                ik_hat_nearest(robot, &hat, near).ok()
+            }
+            _ => None,
+        }
     }
 
     /// A random point: σ uniform, the free values from the state of a uniform joint-space

@@ -201,18 +201,96 @@ class Robot:
     def tip_link(self) -> str:
         """Tip link of the chain (the tool frame)."""
 
-    def fk(self, q: ArrayLike) -> NDArray[np.float64]:
+    def fk(self, q: ArrayLike, out: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
         """The hand frame {W} in {b} at joints ``q`` (shape (7,)), as a 4x4
         homogeneous matrix: origin the wrist centre W, rotation Ow with
-        columns f (finger direction), p (palm normal), f x p."""
+        columns f (finger direction), p (palm normal), f x p.
+
+        ``out``, a writeable C-contiguous float64 array of shape (4, 4), is
+        filled and returned instead of a new array (no allocation per call).
+
+        Raises:
+            TypeError: ``out`` is not a float64 numpy array.
+            ValueError: ``q`` or ``out`` has the wrong shape, or ``out`` is
+                not C-contiguous or not writeable.
+        """
 
     def centers(self, q: ArrayLike) -> dict[str, NDArray[np.float64]]:
         """The arm's points at ``q``: keys ``"shoulder"`` (always the origin),
         ``"elbow"`` and ``"wrist"``, each shape (3,)."""
 
-    def jacobian(self, q: ArrayLike) -> NDArray[np.float64]:
+    def jacobian(self, q: ArrayLike, out: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
         """The geometric Jacobian J_ge, shape (6, 7): rows 0-2 the linear
-        velocity of W, rows 3-5 the angular velocity of the hand, in {b}."""
+        velocity of W, rows 3-5 the angular velocity of the hand, in {b}.
+
+        ``out`` (6, 7) is filled and returned when given, as in :meth:`fk`."""
+
+    def fk_jacobian(
+        self,
+        q: ArrayLike,
+        frame_out: NDArray[np.float64] | None = None,
+        jacobian_out: NDArray[np.float64] | None = None,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``(fk(q), jacobian(q))`` from one forward kinematics: the hand
+        frame (4, 4) and J_ge (6, 7), written into ``frame_out`` and
+        ``jacobian_out`` when given (as ``out`` of :meth:`fk`).
+
+        Raises:
+            TypeError, ValueError: as :meth:`fk`, for either output.
+        """
+
+    def fk_many(self, q: ArrayLike, out: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+        """:meth:`fk` at every row of ``q`` (shape (N, 7)): shape (N, 4, 4).
+
+        A C-contiguous float64 ``q`` is read in place; the rows run with the
+        GIL released, so threads may share a batch. ``out`` (N, 4, 4), if
+        given, is filled and returned.
+
+        Raises:
+            TypeError: ``q`` is not numeric, or ``out`` not a float64 array.
+            ValueError: ``q`` is not (N, 7) or holds NaN or infinity (the
+                message names the row); ``out`` has the wrong shape, is not
+                C-contiguous or writeable, or shares memory with ``q``.
+        """
+
+    def jacobian_many(self, q: ArrayLike, out: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+        """:meth:`jacobian` at every row of ``q`` (N, 7): shape (N, 6, 7);
+        as :meth:`fk_many`."""
+
+    def cpsa_many(self, q: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """:meth:`cpsa` at every row of ``q`` (N, 7): ``(pw (N, 3), ow (N, 3, 3),
+        swivel (N,))``; as :meth:`fk_many`.
+
+        Raises:
+            SingularityError: at a singular row, named in the message.
+            TypeError, ValueError: as :meth:`fk_many`.
+        """
+
+    def ik_cpsa_many(
+        self,
+        pw: ArrayLike,
+        ow: ArrayLike,
+        swivel: ArrayLike,
+        q_near: ArrayLike | None = None,
+        out: NDArray[np.float64] | None = None,
+        on_error: Literal["raise", "nan"] = "raise",
+    ) -> NDArray[np.float64]:
+        """:meth:`ik_cpsa` (nearest solution) for every row of ``pw`` (N, 3),
+        ``ow`` (N, 3, 3) and ``swivel`` (N,): shape (N, 7).
+
+        ``q_near`` is one (7,) for every row or (N, 7), one per row; by
+        default the middle of the joint ranges. A row without a solution
+        raises the exception :meth:`ik_cpsa` would, its message led by the
+        row (``on_error="raise"``), or is NaN (``"nan"``). Runs with the GIL
+        released; ``out`` (N, 7) as in :meth:`fk_many`.
+
+        Raises:
+            UnreachableError, JointLimitError, SingularityError,
+                ConvergenceError: as :meth:`ik_cpsa`, with ``on_error="raise"``.
+            TypeError, ValueError: wrong shapes, row counts that differ, a
+                non-finite entry, a matrix of ``ow`` that is not a rotation
+                (named ``ow[i]``), or an unknown ``on_error``.
+        """
 
     def cpsa(self, q: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
         """The CPSA state ``(pw, ow, swivel)`` at ``q``: wrist position (3,),

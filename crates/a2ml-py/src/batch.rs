@@ -1,0 +1,428 @@
+//! Kinematics over many configurations at once (`Robot.fk_many`, `jacobian_many`,
+//! `cpsa_many`, `ik_cpsa_many`) and the per-call FK + Jacobian (`Robot.fk_jacobian`).
+//!
+//! A call from Python costs more in conversions than the core spends on FK, so these read
+//! float64 arrays in place (any other array-like is converted once), write into arrays the
+//! caller passes (`out=`) or into one array made for the result, and run the rows with the
+//! GIL released. Rows are computed in order on the calling thread: a caller who wants more
+//! threads splits the batch, which the released GIL lets run in parallel.
+
+use a2ml_core::kinematics::{self, ArmPose, CpsaState, KinematicsError};
+use a2ml_core::math::{DOF, Jacobian6x7, JointVector, Matrix3, Real, Vector3};
+use numpy::{
+    AllowTypeChange, IntoPyArray, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyReadwriteArrayDyn,
+    PyUntypedArrayMethods,
+};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+
+use crate::convert::{read_joints, rotation_from, shape_text};
+use crate::errors::CoreError;
+use crate::robot::PyRobot;
+
+/// Values per row of each batched array.
+const FRAME: usize = 16;
+const JACOBIAN: usize = 6 * DOF;
+
+/// A float64 n-dimensional numpy array.
+pub(crate) type Array<'py> = Bound<'py, PyArrayDyn<Real>>;
+
+/// An array-like of shape (N, *row) read as N rows of `row`'s size, row-major: in place when
+/// it is a C-contiguous float64 array, else converted once.
+struct Rows<'py> {
+    array: PyArrayLikeDyn<'py, Real, AllowTypeChange>,
+    /// The values when the array is not C-contiguous.
+    copied: Option<Vec<Real>>,
+    count: usize,
+}
+
+impl Rows<'_> {
+    fn values(&self) -> &[Real] {
+        match &self.copied {
+            Some(values) => values,
+            None => self.array.as_slice().unwrap_or(&[]),
+        }
+    }
+}
+
+/// `(N, 7)` for a row shape `[7]`.
+fn batch_shape_text(row: &[usize]) -> String {
+    let rest: Vec<String> = row.iter().map(|n| n.to_string()).collect();
+    format!("(N, {})", rest.join(", "))
+}
+
+/// The rows of `value`, which must have shape (N, *row) and finite entries; the error names
+/// the argument and, for a non-finite entry, its row.
+fn read_rows<'py>(value: &Bound<'py, PyAny>, name: &str, row: &[usize]) -> PyResult<Rows<'py>> {
+    let like = value.extract::<PyArrayLikeDyn<'py, Real, AllowTypeChange>>().map_err(|e| {
+        let message = format!(
+            "{name} must be an array of numbers of shape {}: {}",
+            batch_shape_text(row),
+            e.value(value.py())
+        );
+        if e.is_instance_of::<PyTypeError>(value.py()) {
+            PyTypeError::new_err(message)
+        } else {
+            PyValueError::new_err(message)
+        }
+    })?;
+    let shape = like.shape();
+    if shape.len() != row.len() + 1 || shape[1..] != *row {
+        return Err(PyValueError::new_err(format!(
+            "{name} must have shape {}, got {}",
+            batch_shape_text(row),
+            shape_text(shape)
+        )));
+    }
+    let count = shape[0];
+    let copied = (!like.is_c_contiguous()).then(|| like.as_array().iter().copied().collect());
+    let rows = Rows { array: like, copied, count };
+    let size: usize = row.iter().product();
+    if let Some(bad) = rows.values().iter().position(|v| !v.is_finite()) {
+        let at = bad.checked_div(size).unwrap_or(0);
+        return Err(PyValueError::new_err(format!("{name}[{at}] contains NaN or infinity")));
+    }
+    Ok(rows)
+}
+
+/// The array a result is written into: the caller's `out` (float64, C-contiguous, writeable,
+/// of exactly `shape`) or a new one.
+fn output<'py>(
+    py: Python<'py>,
+    out: Option<&Bound<'py, PyAny>>,
+    name: &str,
+    shape: &[usize],
+) -> PyResult<Array<'py>> {
+    let Some(out) = out else {
+        return Ok(PyArrayDyn::zeros(py, shape, false));
+    };
+    let array = out.cast::<PyArrayDyn<Real>>().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{name} must be a float64 numpy array of shape {}",
+            shape_text(shape)
+        ))
+    })?;
+    if array.shape() != shape {
+        return Err(PyValueError::new_err(format!(
+            "{name} must have shape {}, got {}",
+            shape_text(shape),
+            shape_text(array.shape())
+        )));
+    }
+    if !array.is_c_contiguous() {
+        return Err(PyValueError::new_err(format!("{name} must be C-contiguous")));
+    }
+    Ok(array.clone())
+}
+
+/// Borrows `array` for writing; an `out` that is not writeable or shares memory with an input
+/// is refused.
+fn writer<'py>(array: &Array<'py>, name: &str) -> PyResult<PyReadwriteArrayDyn<'py, Real>> {
+    array.try_readwrite().map_err(|e| {
+        PyValueError::new_err(format!(
+            "{name} cannot be written ({e}): pass a writeable array \
+             that shares no memory with the inputs"
+        ))
+    })
+}
+
+/// The writer's values: [`output`] arrays are C-contiguous.
+fn slots<'a>(writer: &'a mut PyReadwriteArrayDyn<'_, Real>) -> &'a mut [Real] {
+    writer.as_slice_mut().unwrap_or(&mut [])
+}
+
+/// The hand frame {W} as a row-major 4x4 homogeneous matrix.
+fn write_frame(out: &mut [Real], pose: &ArmPose) {
+    let r = pose.hand.matrix();
+    for i in 0..3 {
+        for j in 0..3 {
+            out[4 * i + j] = r[(i, j)];
+        }
+        out[4 * i + 3] = pose.wrist[i];
+    }
+    out[12..16].copy_from_slice(&[0.0, 0.0, 0.0, 1.0]);
+}
+
+/// J_ge row-major (nalgebra stores it by columns).
+fn write_jacobian(out: &mut [Real], j: &Jacobian6x7) {
+    for i in 0..6 {
+        for k in 0..DOF {
+            out[DOF * i + k] = j[(i, k)];
+        }
+    }
+}
+
+/// `values` (row-major, of `shape`) written into the caller's `out`, or as a new array: made
+/// from the values directly, which costs less than a zeroed array borrowed for writing.
+fn emit<'py>(
+    py: Python<'py>,
+    out: Option<&Bound<'py, PyAny>>,
+    name: &str,
+    shape: &[usize],
+    values: &[Real],
+) -> PyResult<Array<'py>> {
+    if out.is_none() {
+        let array = numpy::ndarray::ArrayD::from_shape_vec(shape, values.to_vec())
+            .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))?;
+        return Ok(array.into_pyarray(py));
+    }
+    let array = output(py, out, name, shape)?;
+    slots(&mut writer(&array, name)?).copy_from_slice(values);
+    Ok(array)
+}
+
+/// The hand frame {W} of `pose` (4x4), written into `out` when given.
+pub(crate) fn frame_into<'py>(
+    py: Python<'py>,
+    pose: &ArmPose,
+    out: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Array<'py>> {
+    let mut values = [0.0; FRAME];
+    write_frame(&mut values, pose);
+    emit(py, out, "out", &[4, 4], &values)
+}
+
+/// J_ge (6x7), written into `out` when given.
+pub(crate) fn jacobian_into<'py>(
+    py: Python<'py>,
+    j: &Jacobian6x7,
+    out: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Array<'py>> {
+    let mut values = [0.0; JACOBIAN];
+    write_jacobian(&mut values, j);
+    emit(py, out, "out", &[6, DOF], &values)
+}
+
+/// A core error of row `row`, as the exception the per-call method raises, its message led
+/// by the row.
+fn row_error(py: Python<'_>, row: usize, e: KinematicsError) -> PyErr {
+    let err = PyErr::from(CoreError::from(e));
+    let message = format!("row {row}: {}", err.value(py));
+    PyErr::from_type(err.get_type(py), message)
+}
+
+/// The per-row outcome of an IK batch.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum OnError {
+    /// The first failing row raises its exception.
+    Raise,
+    /// A failing row is NaN.
+    Nan,
+}
+
+impl OnError {
+    fn parse(text: &str) -> PyResult<Self> {
+        match text {
+            "raise" => Ok(Self::Raise),
+            "nan" => Ok(Self::Nan),
+            other => Err(PyValueError::new_err(format!(
+                "on_error must be \"raise\" or \"nan\", got {other:?}"
+            ))),
+        }
+    }
+}
+
+#[pymethods]
+impl PyRobot {
+    /// The hand frame {W} (4x4) and J_ge (6x7) at `q` from one FK, written into
+    /// `frame_out` and `jacobian_out` when given.
+    #[pyo3(signature = (q, frame_out=None, jacobian_out=None))]
+    fn fk_jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        frame_out: Option<&Bound<'py, PyAny>>,
+        jacobian_out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<(Array<'py>, Array<'py>)> {
+        let pose = kinematics::arm_pose(&self.robot, &read_joints(q, "q")?);
+        let (mut frame, mut jacobian) = ([0.0; FRAME], [0.0; JACOBIAN]);
+        write_frame(&mut frame, &pose);
+        write_jacobian(&mut jacobian, &kinematics::geometric_jacobian(&pose));
+        Ok((
+            emit(py, frame_out, "frame_out", &[4, 4], &frame)?,
+            emit(py, jacobian_out, "jacobian_out", &[6, DOF], &jacobian)?,
+        ))
+    }
+
+    /// The hand frame {W} at each row of `q` (N, 7), as (N, 4, 4).
+    #[pyo3(signature = (q, out=None))]
+    fn fk_many<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Array<'py>> {
+        let rows = read_rows(q, "q", &[DOF])?;
+        let result = output(py, out, "out", &[rows.count, 4, 4])?;
+        let mut guard = writer(&result, "out")?;
+        let (values, out) = (rows.values(), slots(&mut guard));
+        py.detach(|| {
+            for (q, frame) in values.chunks_exact(DOF).zip(out.chunks_exact_mut(FRAME)) {
+                let pose = kinematics::arm_pose(&self.robot, &JointVector::from_column_slice(q));
+                write_frame(frame, &pose);
+            }
+        });
+        drop(guard);
+        Ok(result)
+    }
+
+    /// J_ge at each row of `q` (N, 7), as (N, 6, 7).
+    #[pyo3(signature = (q, out=None))]
+    fn jacobian_many<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Array<'py>> {
+        let rows = read_rows(q, "q", &[DOF])?;
+        let result = output(py, out, "out", &[rows.count, 6, DOF])?;
+        let mut guard = writer(&result, "out")?;
+        let (values, out) = (rows.values(), slots(&mut guard));
+        py.detach(|| {
+            for (q, j) in values.chunks_exact(DOF).zip(out.chunks_exact_mut(JACOBIAN)) {
+                let pose = kinematics::arm_pose(&self.robot, &JointVector::from_column_slice(q));
+                write_jacobian(j, &kinematics::geometric_jacobian(&pose));
+            }
+        });
+        drop(guard);
+        Ok(result)
+    }
+
+    /// The CPSA state at each row of `q` (N, 7): pw (N, 3), ow (N, 3, 3), swivel (N,).
+    fn cpsa_many<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<(Array<'py>, Array<'py>, Array<'py>)> {
+        let rows = read_rows(q, "q", &[DOF])?;
+        let n = rows.count;
+        let (pw, ow, swivel) = (
+            PyArrayDyn::zeros(py, &[n, 3][..], false),
+            PyArrayDyn::zeros(py, &[n, 3, 3][..], false),
+            PyArrayDyn::zeros(py, &[n][..], false),
+        );
+        let (mut pw_guard, mut ow_guard, mut swivel_guard) =
+            (writer(&pw, "pw")?, writer(&ow, "ow")?, writer(&swivel, "swivel")?);
+        let values = rows.values();
+        let (pw_out, ow_out, swivel_out) =
+            (slots(&mut pw_guard), slots(&mut ow_guard), slots(&mut swivel_guard));
+        let failed = py.detach(|| {
+            for (i, q) in values.chunks_exact(DOF).enumerate() {
+                let pose = kinematics::arm_pose(&self.robot, &JointVector::from_column_slice(q));
+                let s = match kinematics::cpsa_state(&self.robot, &pose) {
+                    Ok(s) => s,
+                    Err(e) => return Some((i, e)),
+                };
+                pw_out[3 * i..3 * i + 3].copy_from_slice(s.pw.as_slice());
+                let r = s.ow.matrix();
+                for a in 0..3 {
+                    for b in 0..3 {
+                        ow_out[9 * i + 3 * a + b] = r[(a, b)];
+                    }
+                }
+                swivel_out[i] = s.swivel;
+            }
+            None
+        });
+        if let Some((row, e)) = failed {
+            return Err(row_error(py, row, e));
+        }
+        drop((pw_guard, ow_guard, swivel_guard));
+        Ok((pw, ow, swivel))
+    }
+
+    /// The in-limit IK solution of each CPSA state (pw (N, 3), ow (N, 3, 3), swivel (N,))
+    /// nearest `q_near` ((N, 7), one (7,) for every row, or the middle of the ranges), as
+    /// (N, 7); a row without one raises (`on_error="raise"`) or is NaN (`"nan"`).
+    #[pyo3(signature = (pw, ow, swivel, q_near=None, out=None, on_error="raise"))]
+    #[allow(clippy::too_many_arguments)]
+    fn ik_cpsa_many<'py>(
+        &self,
+        py: Python<'py>,
+        pw: &Bound<'py, PyAny>,
+        ow: &Bound<'py, PyAny>,
+        swivel: &Bound<'py, PyAny>,
+        q_near: Option<&Bound<'py, PyAny>>,
+        out: Option<&Bound<'py, PyAny>>,
+        on_error: &str,
+    ) -> PyResult<Array<'py>> {
+        let on_error = OnError::parse(on_error)?;
+        let pw = read_rows(pw, "pw", &[3])?;
+        let n = pw.count;
+        let ow = read_rows(ow, "ow", &[3, 3])?;
+        let swivel = read_rows(swivel, "swivel", &[])?;
+        for (name, count) in [("ow", ow.count), ("swivel", swivel.count)] {
+            if count != n {
+                return Err(PyValueError::new_err(format!(
+                    "{name} has {count} rows, pw has {n}: one state per row"
+                )));
+            }
+        }
+        // One q_near for every row, or one per row.
+        let per_row = |value: &Bound<'py, PyAny>| {
+            value
+                .extract::<PyArrayLikeDyn<'py, Real, AllowTypeChange>>()
+                .is_ok_and(|a| a.ndim() == 2)
+        };
+        let (near_one, near_rows) = match q_near {
+            None => (None, None),
+            Some(value) if per_row(value) => {
+                let rows = read_rows(value, "q_near", &[DOF])?;
+                if rows.count != n {
+                    return Err(PyValueError::new_err(format!(
+                        "q_near has {} rows, pw has {n}: one per row, or one of shape (7,)",
+                        rows.count
+                    )));
+                }
+                (None, Some(rows))
+            }
+            Some(value) => (Some(read_joints(value, "q_near")?), None),
+        };
+        // Rotations are checked like the per-call method's, with the GIL, before any IK.
+        let rotations = ow
+            .values()
+            .chunks_exact(9)
+            .enumerate()
+            .map(|(i, m)| rotation_from(Matrix3::from_row_slice(m), &format!("ow[{i}]")))
+            .collect::<PyResult<Vec<_>>>()?;
+        let result = output(py, out, "out", &[n, DOF])?;
+        let mut guard = writer(&result, "out")?;
+        let out = slots(&mut guard);
+        let (pw, swivel) = (pw.values(), swivel.values());
+        let near_values = near_rows.as_ref().map(|r| r.values());
+        let failed = py.detach(|| {
+            for (i, q) in out.chunks_exact_mut(DOF).enumerate() {
+                let target = CpsaState {
+                    pw: Vector3::from_column_slice(&pw[3 * i..3 * i + 3]),
+                    ow: rotations[i],
+                    swivel: swivel[i],
+                };
+                let near = near_values
+                    .map(|v| JointVector::from_column_slice(&v[DOF * i..DOF * i + DOF]))
+                    .or(near_one);
+                // The nearest solution alone: ik_cpsa's first, without the others. Without a
+                // q_near, ik_cpsa itself: a numerical arm then tries its guesses first.
+                let solved = match near {
+                    Some(near) => kinematics::ik_cpsa_nearest(&self.robot, &target, &near),
+                    None => kinematics::ik_cpsa(&self.robot, &target, None).and_then(|s| {
+                        s.into_iter().next().ok_or(KinematicsError::NoConvergence {
+                            residual: Real::INFINITY,
+                            starts: 0,
+                        })
+                    }),
+                };
+                match solved {
+                    Ok(solution) => q.copy_from_slice(solution.as_slice()),
+                    Err(e) if on_error == OnError::Raise => return Some((i, e)),
+                    Err(_) => q.fill(Real::NAN),
+                }
+            }
+            None
+        });
+        if let Some((row, e)) = failed {
+            return Err(row_error(py, row, e));
+        }
+        drop(guard);
+        Ok(result)
+    }
+}

@@ -1,0 +1,195 @@
+"""The batched kinematics of a2ml.Robot (fk_many, jacobian_many, cpsa_many, ik_cpsa_many)
+and the per-call outputs (out=, fk_jacobian): each equals the per-call method row by row,
+writes where it is asked to, and refuses bad shapes, dtypes and values with a clear
+exception."""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numpy.typing import NDArray
+
+from a2ml import Robot, SingularityError, UnreachableError
+
+ROBOTS_DIR = Path(__file__).resolve().parents[2] / "robots"
+NAMES = ["coman_right_arm", "centauro_right_arm", "iiwa14", "panda", "human_arm"]
+
+_cache: dict[str, Robot] = {}
+
+
+def robot(name: str) -> Robot:
+    if name not in _cache:
+        _cache[name] = Robot.from_urdf(ROBOTS_DIR / f"{name}.urdf")
+    return _cache[name]
+
+
+def configurations(r: Robot, count: int, seed: int = 3) -> NDArray[np.float64]:
+    """Uniform in the middle 80 % of every range: regular, in limits."""
+    rng = np.random.default_rng(seed)
+    span = r.upper - r.lower
+    return rng.uniform(r.lower + 0.1 * span, r.upper - 0.1 * span, size=(count, 7))
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_batches_equal_the_per_call_methods(name: str) -> None:
+    r = robot(name)
+    qs = configurations(r, 40)
+    frames, jacobians = r.fk_many(qs), r.jacobian_many(qs)
+    pw, ow, swivel = r.cpsa_many(qs)
+    assert frames.shape == (40, 4, 4) and jacobians.shape == (40, 6, 7)
+    assert pw.shape == (40, 3) and ow.shape == (40, 3, 3) and swivel.shape == (40,)
+    for i, q in enumerate(qs):
+        # The same core functions on the same values: equal to the last bit.
+        np.testing.assert_array_equal(frames[i], r.fk(q))
+        np.testing.assert_array_equal(jacobians[i], r.jacobian(q))
+        p, o, s = r.cpsa(q)
+        np.testing.assert_array_equal(pw[i], p)
+        np.testing.assert_array_equal(ow[i], o)
+        assert swivel[i] == s
+
+
+@pytest.mark.parametrize("name", ["iiwa14", "panda", "centauro_right_arm", "human_arm"])
+def test_ik_cpsa_many_equals_ik_cpsa_and_reaches_the_states(name: str) -> None:
+    r = robot(name)
+    qs = configurations(r, 12, seed=5)
+    pw, ow, swivel = r.cpsa_many(qs)
+    near = qs + 0.01
+    solved = r.ik_cpsa_many(pw, ow, swivel, near)
+    assert solved.shape == (12, 7)
+    for i in range(12):
+        np.testing.assert_array_equal(solved[i], r.ik_cpsa(pw[i], ow[i], float(swivel[i]), near[i]))
+    # Each solution reaches its state.
+    back_pw, back_ow, back_swivel = r.cpsa_many(solved)
+    np.testing.assert_allclose(back_pw, pw, atol=1e-8)
+    np.testing.assert_allclose(back_ow, ow, atol=1e-8)
+    np.testing.assert_allclose(np.angle(np.exp(1j * (back_swivel - swivel))), 0.0, atol=1e-8)
+    # One q_near for every row, and the default, agree with the per-call method too.
+    one = r.ik_cpsa_many(pw, ow, swivel, qs[0])
+    default = r.ik_cpsa_many(pw, ow, swivel)
+    for i in range(12):
+        np.testing.assert_array_equal(one[i], r.ik_cpsa(pw[i], ow[i], float(swivel[i]), qs[0]))
+        np.testing.assert_array_equal(default[i], r.ik_cpsa(pw[i], ow[i], float(swivel[i])))
+
+
+def test_out_arrays_are_filled_and_returned() -> None:
+    r = robot("iiwa14")
+    qs = configurations(r, 5)
+    frame, jacobian = np.full((4, 4), np.nan), np.full((6, 7), np.nan)
+    assert r.fk(qs[0], frame) is frame
+    np.testing.assert_array_equal(frame, r.fk(qs[0]))
+    assert r.jacobian(qs[1], out=jacobian) is jacobian
+    np.testing.assert_array_equal(jacobian, r.jacobian(qs[1]))
+    f, j = r.fk_jacobian(qs[2], frame, jacobian)
+    assert f is frame and j is jacobian
+    np.testing.assert_array_equal(frame, r.fk(qs[2]))
+    np.testing.assert_array_equal(jacobian, r.jacobian(qs[2]))
+    f, j = r.fk_jacobian(qs[3])
+    np.testing.assert_array_equal(f, r.fk(qs[3]))
+    np.testing.assert_array_equal(j, r.jacobian(qs[3]))
+    frames, jacobians = np.empty((5, 4, 4)), np.empty((5, 6, 7))
+    assert r.fk_many(qs, frames) is frames and r.jacobian_many(qs, out=jacobians) is jacobians
+    np.testing.assert_array_equal(frames, r.fk_many(qs))
+    np.testing.assert_array_equal(jacobians, r.jacobian_many(qs))
+    pw, ow, swivel = r.cpsa_many(qs)
+    solutions = np.empty((5, 7))
+    assert r.ik_cpsa_many(pw, ow, swivel, qs, out=solutions) is solutions
+    np.testing.assert_array_equal(solutions, r.ik_cpsa_many(pw, ow, swivel, qs))
+
+
+def test_any_array_like_is_accepted() -> None:
+    r = robot("iiwa14")
+    qs = configurations(r, 6)
+    expected = r.fk_many(qs)
+    # A list, a Fortran-ordered copy, a strided view and float32 are converted.
+    np.testing.assert_array_equal(r.fk_many(qs.tolist()), expected)
+    np.testing.assert_array_equal(r.fk_many(np.asfortranarray(qs)), expected)
+    doubled = np.repeat(qs, 2, axis=0)
+    np.testing.assert_array_equal(r.fk_many(doubled[::2]), expected)
+    np.testing.assert_allclose(r.fk_many(qs.astype(np.float32)), expected, atol=1e-6)
+    np.testing.assert_array_equal(r.fk(qs[0].tolist()), expected[0])
+    np.testing.assert_array_equal(r.fk(np.repeat(qs[0], 2)[::2]), expected[0])
+    # An empty batch is an empty result.
+    assert r.fk_many(np.empty((0, 7))).shape == (0, 4, 4)
+    assert r.ik_cpsa_many(np.empty((0, 3)), np.empty((0, 3, 3)), np.empty(0)).shape == (0, 7)
+
+
+def test_bad_shapes_and_values_raise_clear_errors() -> None:
+    r = robot("iiwa14")
+    qs = configurations(r, 4)
+    with pytest.raises(ValueError, match=r"q must have shape \(N, 7\), got \(7,\)"):
+        r.fk_many(qs[0])
+    with pytest.raises(ValueError, match=r"q must have shape \(N, 7\), got \(4, 6\)"):
+        r.jacobian_many(qs[:, :6])
+    with pytest.raises(ValueError, match="q must be an array of numbers"):
+        r.cpsa_many([["a"] * 7])
+    bad = qs.copy()
+    bad[2, 3] = np.nan
+    with pytest.raises(ValueError, match=r"q\[2\] contains NaN or infinity"):
+        r.fk_many(bad)
+    with pytest.raises(ValueError, match="q contains NaN or infinity"):
+        r.fk(bad[2])
+    with pytest.raises(ValueError, match=r"out must have shape \(4, 4, 4\), got \(4, 4\)"):
+        r.fk_many(qs, np.empty((4, 4)))
+    with pytest.raises(TypeError, match="out must be a float64 numpy array"):
+        r.fk(qs[0], np.empty((4, 4), dtype=np.float32))
+    with pytest.raises(ValueError, match="out must be C-contiguous"):
+        r.jacobian(qs[0], np.empty((7, 6)).T)
+    frozen = np.empty((6, 7))
+    frozen.flags.writeable = False
+    with pytest.raises(ValueError, match="out cannot be written"):
+        r.jacobian(qs[0], frozen)
+    with pytest.raises(ValueError, match=r"jacobian_out must have shape \(6, 7\)"):
+        r.fk_jacobian(qs[0], np.empty((4, 4)), np.empty((7, 6)))
+    pw, ow, swivel = r.cpsa_many(qs)
+    with pytest.raises(ValueError, match="ow has 3 rows, pw has 4"):
+        r.ik_cpsa_many(pw, ow[:3], swivel)
+    with pytest.raises(ValueError, match=r"ow must have shape \(N, 3, 3\)"):
+        r.ik_cpsa_many(pw, ow[:, 0], swivel)
+    with pytest.raises(ValueError, match="q_near has 2 rows, pw has 4"):
+        r.ik_cpsa_many(pw, ow, swivel, qs[:2])
+    reflected = ow.copy()
+    reflected[1] = -reflected[1]
+    with pytest.raises(ValueError, match=r"ow\[1\] is a reflection"):
+        r.ik_cpsa_many(pw, reflected, swivel)
+    with pytest.raises(ValueError, match='on_error must be "raise" or "nan"'):
+        r.ik_cpsa_many(pw, ow, swivel, on_error="skip")  # type: ignore[arg-type]
+    # The output must not be an input: q_near written while it is read.
+    with pytest.raises(ValueError, match="out cannot be written"):
+        r.ik_cpsa_many(pw, ow, swivel, qs, out=qs)
+
+
+def test_failing_rows_raise_with_their_row_or_are_nan() -> None:
+    r = robot("iiwa14")
+    qs = configurations(r, 3)
+    pw, ow, swivel = r.cpsa_many(qs)
+    pw[1] *= 10.0  # far outside the reach
+    with pytest.raises(UnreachableError, match="^row 1: "):
+        r.ik_cpsa_many(pw, ow, swivel)
+    solved = r.ik_cpsa_many(pw, ow, swivel, qs, on_error="nan")
+    assert np.isnan(solved[1]).all()
+    np.testing.assert_array_equal(solved[[0, 2]], r.ik_cpsa_many(pw[[0, 2]], ow[[0, 2]], swivel[[0, 2]], qs[[0, 2]]))
+    straight = qs.copy()
+    straight[2, 3] = 0.0  # iiwa: the elbow straight, the arm plane undefined
+    with pytest.raises(SingularityError, match="^row 2: "):
+        r.cpsa_many(straight)
+
+
+def test_threads_share_a_batch() -> None:
+    """The GIL is released around the rows: batches in threads give the same results."""
+    r = robot("panda")
+    qs = configurations(r, 2000)
+    expected = r.jacobian_many(qs)
+    results: list[NDArray[np.float64]] = [np.empty(0)] * 4
+
+    def work(k: int) -> None:
+        results[k] = r.jacobian_many(qs[k * 500 : (k + 1) * 500])
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    np.testing.assert_array_equal(np.concatenate(results), expected)
