@@ -215,6 +215,10 @@ pub struct FeatureReport {
     pub size: Option<Real>,
     /// An angle size in degrees.
     pub size_deg: Option<Real>,
+    /// The point an `arc` passes through (m, {b}).
+    pub through: Option<[Real; 3]>,
+    /// The end of an `arc`, the action's Pw goal (m, {b}).
+    pub to: Option<[Real; 3]>,
 }
 
 /// Where the action order comes from.
@@ -369,9 +373,14 @@ impl FeatureReport {
                 ("about", None, Some(text::axis(axis)), angle(*a))
             }
             PathFeature::By { angle: a } => ("by", None, None, angle(Some(*a))),
+            PathFeature::Arc { .. } => ("arc", None, None, (None, None)),
             PathFeature::Hold => ("hold", None, None, (None, None)),
         };
-        Self { feature: name, direction, axis, size, size_deg }
+        let (through, to) = match feature {
+            PathFeature::Arc { through, to } => (Some(vec3(through)), to.as_ref().map(vec3)),
+            _ => (None, None),
+        };
+        Self { feature: name, direction, axis, size, size_deg, through, to }
     }
 }
 
@@ -769,6 +778,11 @@ mod text {
                 sized(format!("about {}", axis(a)), *angle, "about")
             }
             PathFeature::By { angle } => format!("by {}", size("by", *angle)),
+            PathFeature::Arc { through, to } => {
+                let to =
+                    to.map_or_else(String::new, |to| format!(" to {}", list(&vec3(&to), FINE)));
+                format!("arc through {}{to}", list(&vec3(through), FINE))
+            }
             PathFeature::Hold => "hold".to_owned(),
         }
     }

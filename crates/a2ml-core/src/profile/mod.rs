@@ -6,12 +6,14 @@
 //! (+Tr) and [`join_sequential`] (+Se). Time t is in s from the start of the primitive or
 //! segment; values and velocities are in {b}, angular velocities spatial (`Ṙ = [ω]× R`).
 
+mod arc;
 mod bell;
 mod error;
 mod join;
 mod reference;
 mod weights;
 
+pub use arc::SemiEllipse;
 pub use bell::BellProfile;
 pub use error::ProfileError;
 pub use join::{

@@ -1,10 +1,10 @@
 //! Reference paths of the movement primitives: the value of one state variable and its time
 //! derivative at any t, moving along the primitive's path with a bell speed (paper eq. 9).
 
-use super::{BellProfile, ProfileError};
+use super::{BellProfile, ProfileError, SemiEllipse};
 use crate::language::{Axis, BodyAxis, PathFeature, Target, ValueKind, Variable};
 use crate::math::{
-    Real, Rotation3, Vector3, reject, rotation_about, rotation_log, skew, wrap_angle,
+    PI, Real, Rotation3, Vector3, reject, rotation_about, rotation_log, skew, wrap_angle,
 };
 
 /// Directions shorter than this are treated as undefined.
@@ -92,9 +92,13 @@ pub enum PositionPath {
         /// Unit axis in {b}.
         axis: Vector3,
     },
+    /// Pw along a semi-ellipse from the start to the goal (`arc through`); the distance is
+    /// its eccentric angle, π at the goal.
+    Arc(SemiEllipse),
 }
 
-/// The reference of Pw (m, in {b}): a line, a rotation about an axis through S, or a hold.
+/// The reference of Pw (m, in {b}): a line, a rotation about an axis through S, a
+/// semi-elliptic arc, or a hold.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PositionReference {
     start: Vector3,
@@ -167,6 +171,16 @@ impl PositionReference {
         Ok(Self { start, path: PositionPath::About { axis }, bell })
     }
 
+    /// Pw along the semi-ellipse `arc` from its start to its end, the bell over its
+    /// eccentric angle (0 to π).
+    ///
+    /// # Errors
+    /// An invalid duration.
+    pub fn arc(arc: SemiEllipse, duration: Real) -> Result<Self, ProfileError> {
+        let bell = BellProfile::new(duration, PI)?;
+        Ok(Self { start: arc.start(), path: PositionPath::Arc(arc), bell })
+    }
+
     /// Pw at t = 0 (m, {b}).
     pub fn start(&self) -> Vector3 {
         self.start
@@ -194,12 +208,13 @@ impl PositionReference {
             PositionPath::Hold => (p, Vector3::zeros()),
             PositionPath::Line { direction } => (p, direction * speed),
             PositionPath::About { axis } => (p, axis.cross(&p) * speed),
+            PositionPath::Arc(arc) => (p, arc.tangent(self.bell.progress(t)) * speed),
         }
     }
 
     /// The distance along the path (unbounded, as [`Self::at_distance`]) of the path's point
-    /// nearest to `p`: its projection on a line, its angle about the axis for a rotation (in
-    /// (-π, π]); 0 for a hold.
+    /// nearest to `p`: its projection on a line, its angle about the axis for a rotation, its
+    /// eccentric angle on an arc (both in (-π, π]); 0 for a hold.
     pub fn nearest_distance(&self, p: &Vector3) -> Real {
         match self.path {
             PositionPath::Hold => 0.0,
@@ -208,6 +223,7 @@ impl PositionReference {
                 let (a, b) = (reject(&self.start, &axis), reject(p, &axis));
                 axis.dot(&a.cross(&b)).atan2(a.dot(&b))
             }
+            PositionPath::Arc(arc) => arc.nearest(p),
         }
     }
 
@@ -218,6 +234,7 @@ impl PositionReference {
             PositionPath::Hold => self.start,
             PositionPath::Line { direction } => self.start + direction * s,
             PositionPath::About { axis } => rotation_about(&axis, s) * self.start,
+            PositionPath::Arc(arc) => arc.at(s),
         }
     }
 }
@@ -579,6 +596,7 @@ impl Reference {
             PathFeature::Line { .. } => "line",
             PathFeature::About { .. } => "about",
             PathFeature::By { .. } => "by",
+            PathFeature::Arc { .. } => "arc",
             PathFeature::Hold => "hold",
         };
         let missing = || ProfileError::MissingSize { variable, feature: keyword };
@@ -597,6 +615,10 @@ impl Reference {
                 let angle = angle.ok_or_else(missing)?;
                 let axis = resolve_axis(&axis, frames)?;
                 Reference::Rotation(RotationReference::about(r, &axis, angle, duration)?)
+            }
+            (PathFeature::Arc { through, to }, Target::Position(p)) => {
+                let arc = SemiEllipse::through(p, to.ok_or_else(missing)?, through)?;
+                Reference::Position(PositionReference::arc(arc, duration)?)
             }
             (PathFeature::By { angle }, Target::Angle(a)) => Reference::Angle(AngleReference::by(
                 a,
