@@ -38,13 +38,24 @@ draw "$here/type_vii_about_minus_z.a2ml" joints fig9b_joints
 draw "$here/type_vii_about_r.a2ml" featured fig9a_featured
 draw "$here/type_vii_about_minus_z.a2ml" featured fig9b_featured
 
-# §6.3, fig. 10(a) and 11: the column run, and each capsule's distance to the column.
+# §6.3, fig. 10(a) and 11: the column run (MS1 by the constrained RRT), and each capsule's
+# distance to the column; both variants of fig. 9, which end in one configuration.
 draw "$here/type_vii_column.a2ml" wrist fig10a_wrist
+draw "$here/type_vii_column.a2ml" joints fig10a_joints
 draw "$here/type_vii_column.a2ml" distances fig11_distances
+draw "$here/type_vii_column_about_minus_z.a2ml" wrist fig10a_minus_z_wrist
+draw "$here/type_vii_column_about_minus_z.a2ml" distances fig11_minus_z_distances
 
 # §6.3, fig. 10(b): GPM on the straight wrist path, through the column and past joint 6's limit.
 draw "$here/column_gpm_straight.a2ml" joints fig10b_joints
 draw "$here/column_gpm_straight.a2ml" distances fig10b_distances
+
+# §6.3, fig. 12: GPM on the three semi-elliptic wrist paths: the paths (a) and the joints,
+# joints 4 (RElbj) and 6 (RWrj1) among them against their shaded limits (b, c).
+for plane in minus30 0 plus30; do
+  draw "$here/column_gpm_arc_$plane.a2ml" wrist "fig12a_wrist_$plane"
+  draw "$here/column_gpm_arc_$plane.a2ml" joints "fig12_joints_$plane"
+done
 
 # §6.4, fig. 13(d) and (e): the push-box task's joints on Centauro and on COMAN.
 draw "$here/../push_box_aside_centauro.a2ml" joints fig13d_joints

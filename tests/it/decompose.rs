@@ -333,9 +333,10 @@ fn decompose_example(path: &Path) -> (Robot, Task, Result<Decomposition, Decompo
 /// nowhere to plan from.
 #[test]
 fn every_example_decomposes() {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
-        .expect("examples folder")
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut paths: Vec<PathBuf> = ["examples", "examples/paper"]
+        .iter()
+        .flat_map(|f| std::fs::read_dir(root.join(f)).expect("examples folder"))
         .map(|e| e.expect("entry").path())
         .filter(|p| p.extension().is_some_and(|e| e == "a2ml"))
         .collect();

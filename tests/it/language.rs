@@ -76,6 +76,8 @@ mod malformed {
     malformed!(vector_length, 4, 15, "Pw needs 3 numbers, but 2 are given");
     malformed!(line_on_angle, 4, 10, "`line` moves Pw, not θsw");
     malformed!(by_on_position, 4, 10, "`by` changes θsw or θe, not Pw");
+    malformed!(arc_on_rotation, 5, 10, "`arc` moves Pw, not Ow");
+    malformed!(arc_without_pw_goal, 5, 10, "`arc` runs from the start to the action's Pw goal");
     malformed!(zero_line_direction, 4, 18, "the line direction must not be zero");
     malformed!(negative_path_size, 4, 28, "the line length must be positive");
     malformed!(zero_by, 4, 17, "`by` needs a non-zero angle");
@@ -151,9 +153,10 @@ fn every_corpus_file_has_a_test() {
 /// the same syntax tree comes back; printing again changes nothing.
 #[test]
 fn examples_validate_and_round_trip_through_fmt() {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples");
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let mut count = 0;
-    for entry in std::fs::read_dir(dir).expect("examples folder") {
+    let folders = ["examples", "examples/paper"].map(|f| root.join(f));
+    for entry in folders.iter().flat_map(|d| std::fs::read_dir(d).expect("examples folder")) {
         let path = entry.expect("entry").path();
         if path.extension().and_then(|e| e.to_str()) != Some("a2ml") {
             continue;
@@ -407,7 +410,7 @@ fn fmt_laws_over_the_examples_and_the_malformed_corpus() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let mut formatted = 0;
     let mut refused = 0;
-    for folder in ["examples", "tests/malformed"] {
+    for folder in ["examples", "examples/paper", "tests/malformed"] {
         for entry in std::fs::read_dir(root.join(folder)).expect("folder") {
             let path = entry.expect("entry").path();
             if path.extension().and_then(|e| e.to_str()) != Some("a2ml") {

@@ -327,7 +327,7 @@ fn axis<'py>(py: Python<'py>, a: &Axis) -> PyResult<Bound<'py, PyAny>> {
     })
 }
 
-/// `{"kind": "line" | "about" | "by" | "hold", ...}`.
+/// `{"kind": "line" | "about" | "by" | "arc" | "hold", ...}`.
 fn feature<'py>(py: Python<'py>, f: &PathFeature) -> PyResult<Dict<'py>> {
     let d = PyDict::new(py);
     match f {
@@ -344,6 +344,11 @@ fn feature<'py>(py: Python<'py>, f: &PathFeature) -> PyResult<Dict<'py>> {
         PathFeature::By { angle } => {
             d.set_item("kind", "by")?;
             d.set_item("angle", angle)?;
+        }
+        PathFeature::Arc { through, to } => {
+            d.set_item("kind", "arc")?;
+            d.set_item("through", to_vector(py, through.as_slice()))?;
+            d.set_item("to", to.map(|to| to_vector(py, to.as_slice())))?;
         }
         PathFeature::Hold => d.set_item("kind", "hold")?,
     }

@@ -216,6 +216,10 @@ pub struct FeatureReport {
     pub size: Option<Real>,
     /// An angle size in degrees.
     pub size_deg: Option<Real>,
+    /// The point an `arc` passes through (m, {b}).
+    pub through: Option<[Real; 3]>,
+    /// The end of an `arc`, the action's Pw goal (m, {b}).
+    pub to: Option<[Real; 3]>,
 }
 
 /// Where the action order comes from.
@@ -364,9 +368,14 @@ impl FeatureReport {
                 ("about", None, Some(axis.to_string()), angle(*a))
             }
             PathFeature::By { angle: a } => ("by", None, None, angle(Some(*a))),
+            PathFeature::Arc { .. } => ("arc", None, None, (None, None)),
             PathFeature::Hold => ("hold", None, None, (None, None)),
         };
-        Self { feature: name, direction, axis, size, size_deg }
+        let (through, to) = match feature {
+            PathFeature::Arc { through, to } => (Some(vec3(through)), to.as_ref().map(vec3)),
+            _ => (None, None),
+        };
+        Self { feature: name, direction, axis, size, size_deg, through, to }
     }
 }
 

@@ -9,7 +9,7 @@ use crate::{a2ml, scratch, stderr, stdout};
 
 /// What an example's comments promise.
 struct Outcome {
-    /// The file in `examples/`.
+    /// The file in `examples/` (`paper/..` for the paper's §6, `examples/paper/`).
     file: &'static str,
     /// Exit code of `a2ml explain`.
     explain: i32,
@@ -95,6 +95,44 @@ const OUTCOMES: &[Outcome] = &[
     },
     ok("type_vi_elbow_hold.a2ml"),
     ok("type_vii_column.a2ml"),
+    // Paper §6 (docs/paper.md). GPM on the semi-elliptic wrist paths (fig. 12) drives joints
+    // past their limits, and on the straight one (fig. 10(b)) the hand into the column.
+    Outcome {
+        file: "paper/column_gpm_arc_0.a2ml",
+        explain: 0,
+        plan: 3,
+        plan_says: &["action `reach`, segment 1", "limit"],
+    },
+    Outcome {
+        file: "paper/column_gpm_arc_minus30.a2ml",
+        explain: 0,
+        plan: 3,
+        plan_says: &["action `reach`, segment 1", "limit"],
+    },
+    Outcome {
+        file: "paper/column_gpm_arc_plus30.a2ml",
+        explain: 0,
+        plan: 3,
+        plan_says: &["action `reach`, segment 1", "limit"],
+    },
+    Outcome {
+        file: "paper/column_gpm_straight.a2ml",
+        explain: 0,
+        plan: 3,
+        plan_says: &["action `reach`, segment 1", "column"],
+    },
+    // The QP keeps the hard line and the bar stops it there, short of the goal (fig. 7(a)).
+    Outcome {
+        file: "paper/forward_bar_qp.a2ml",
+        explain: 0,
+        plan: 3,
+        plan_says: &["action `rise_along_line`, segment 1: missed", "stalled"],
+    },
+    ok("paper/type_vii_about_minus_z.a2ml"),
+    ok("paper/type_vii_about_r.a2ml"),
+    // MS1 by the constrained RRT; MS2 `auto` (the QP stalls, the RRT takes it), MS3 QP.
+    ok("paper/type_vii_column.a2ml"),
+    ok("paper/type_vii_column_about_minus_z.a2ml"),
 ];
 
 fn examples_folder() -> PathBuf {
@@ -103,13 +141,18 @@ fn examples_folder() -> PathBuf {
 
 #[test]
 fn every_example_is_listed() {
-    let mut found: Vec<String> = fs::read_dir(examples_folder())
-        .expect("examples/")
-        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+    let mut found: Vec<String> = ["", "paper/"]
+        .iter()
+        .flat_map(|sub| {
+            fs::read_dir(examples_folder().join(sub))
+                .expect("examples/")
+                .map(move |e| format!("{sub}{}", e.expect("entry").file_name().to_string_lossy()))
+        })
         .filter(|name| name.ends_with(".a2ml"))
         .collect();
     found.sort_unstable();
-    let listed: Vec<&str> = OUTCOMES.iter().map(|o| o.file).collect();
+    let mut listed: Vec<&str> = OUTCOMES.iter().map(|o| o.file).collect();
+    listed.sort_unstable();
     assert_eq!(found, listed);
 }
 
@@ -137,7 +180,7 @@ fn every_example_checks_explains_and_plans_as_documented() {
             }
         }
 
-        let mcap = dir.join(outcome.file.replace(".a2ml", ".mcap"));
+        let mcap = dir.join(outcome.file.replace('/', "_").replace(".a2ml", ".mcap"));
         let plan = a2ml(&["plan", &file, "-o", &mcap.to_string_lossy()]);
         let (out, err) = (stdout(&plan), stderr(&plan));
         assert_eq!(plan.status.code(), Some(outcome.plan), "plan {}: {out}\n{err}", outcome.file);

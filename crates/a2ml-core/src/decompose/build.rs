@@ -562,6 +562,7 @@ fn feature_size(feature: &PathFeature) -> Real {
         PathFeature::Line { length, .. } => length.unwrap_or(0.0),
         PathFeature::About { angle, .. } => angle.unwrap_or(0.0),
         PathFeature::By { angle } => *angle,
+        PathFeature::Arc { .. } => crate::math::PI,
         PathFeature::Hold => 0.0,
     }
 }

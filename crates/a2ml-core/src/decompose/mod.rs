@@ -18,7 +18,9 @@ pub use build::{
 pub use classify::{
     ActionType, Classification, Combination, SegmentPattern, classify, segment_pattern,
 };
-pub use opt::{ArmState, OptError, OptOptions, OptSolution, along_path, goal_error, opt1, opt2};
+pub use opt::{
+    ArmState, OptError, OptOptions, OptSolution, along_path, goal_error, goal_margin, opt1, opt2,
+};
 pub use strips::{StripsOptions, order, order_with};
 
 use crate::language::Variable;

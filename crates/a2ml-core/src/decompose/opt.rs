@@ -5,8 +5,9 @@
 //! (Opt1) or from a path and its size (Opt2); the free ones are searched by
 //! Levenberg-Marquardt with multistart, every candidate checked through the
 //! CPSA <-> HAT mapping and IK within the joint limits, the end state kept
-//! clear of the scene by [`OptOptions::clearance`] and off the limits by
-//! [`OptOptions::limit_margin`]. A one-dimensional search over θsw first
+//! clear of the scene by [`OptOptions::clearance`] plus, where an end with that room
+//! exists, what the goal tolerance lets the arm move ([`goal_margin`]), and off the limits
+//! by [`OptOptions::limit_margin`]. A one-dimensional search over θsw first
 //! samples the closed-form feasible swivel intervals.
 
 use crate::collision::{CollisionScene, min_distance};
@@ -16,8 +17,9 @@ use crate::kinematics::{
 };
 use crate::language::{Axis, BodyAxis, PathConstraint, PathFeature, Space, Target, Variable};
 use crate::math::{
-    JointVector, PI, Real, Rotation3, Vector3, rotation_about, rotation_log, wrap_angle,
+    DOF, JointVector, PI, Real, Rotation3, Vector3, rotation_about, rotation_log, wrap_angle,
 };
+use crate::profile::SemiEllipse;
 use crate::robot::Robot;
 
 /// The arm's state in both spaces at once.
@@ -121,9 +123,16 @@ pub struct OptOptions {
     pub max_path_size: Real,
     /// Samples of the feasible swivel range for a search over θsw alone.
     pub swivel_samples: usize,
-    /// Smallest distance (m) every arm capsule keeps from the obstacles and
-    /// from the other links at the end state.
+    /// The safety distance (m): every arm capsule keeps it from the obstacles and from the
+    /// other links at the end state, plus [`goal_margin`] where an end
+    /// with that room exists.
     pub clearance: Real,
+    /// The goal tolerance of the solvers that will reach the end state: position (m) and
+    /// rotation or angle (rad), default 1 mm and 1°. An end chosen here is a free choice,
+    /// not a user's goal, so it is kept far enough from the obstacles that every state a
+    /// solver may stop in as reached still keeps the safety distance, and an RRT rooting
+    /// its goal tree there has room for its conservative edge checks.
+    pub goal_tolerance: (Real, Real),
     /// Smallest distance (rad) every joint keeps from its limits at the end
     /// state. An optimum often lies on a limit (a path as long as the arm
     /// allows); a solver that keeps its own margin from the limits, as the
@@ -141,6 +150,7 @@ impl Default for OptOptions {
             max_path_size: 1.0,
             swivel_samples: 72,
             clearance: 0.01,
+            goal_tolerance: (1e-3, (1.0 as Real).to_radians()),
             limit_margin: 1e-3,
         }
     }
@@ -177,6 +187,7 @@ pub enum OptError {
 
 /// The free parameters of a search: offsets of some variables of one space
 /// (positions in m, rotation vectors, angles) and path sizes.
+#[derive(Clone)]
 struct Search<'a> {
     robot: &'a Robot,
     start_q: JointVector,
@@ -190,6 +201,9 @@ struct Search<'a> {
     goals: &'a [(Variable, Target)],
     options: &'a OptOptions,
     scene: Option<&'a CollisionScene>,
+    /// The distance (m) the end state keeps: the safety distance, with [`goal_margin`] where
+    /// an end with that room exists.
+    kept: Real,
     evaluations: usize,
     /// Whether each evaluation checks the points along a hard path, or only the end
     /// (the first pass; its winner is checked afterwards).
@@ -226,6 +240,10 @@ pub fn along_path(v: Variable, feature: &PathFeature, s: Real, start: &ArmState)
             Rotation3::from_matrix_unchecked(rotation_about(&axis_vector(axis, start), s)) * r,
         ),
         (PathFeature::By { .. }, Target::Angle(a)) => Target::Angle(a + s),
+        // s is the eccentric angle, π at the arc's end.
+        (PathFeature::Arc { through, to: Some(to) }, Target::Position(p)) => {
+            Target::Position(SemiEllipse::through(p, *to, *through).map_or(*to, |e| e.at(s)))
+        }
         _ => value,
     }
 }
@@ -289,6 +307,7 @@ impl Search<'_> {
                 (PathFeature::Line { length, .. }, None) => length.unwrap_or(0.0),
                 (PathFeature::About { angle, .. }, None) => angle.unwrap_or(0.0),
                 (PathFeature::By { angle }, None) => *angle,
+                (PathFeature::Arc { .. }, None) => PI,
                 (PathFeature::Hold, None) => 0.0,
             })
             .collect()
@@ -333,7 +352,7 @@ impl Search<'_> {
     fn clear(&self, q: &JointVector) -> bool {
         let Some(scene) = self.scene else { return true };
         min_distance(self.robot, &arm_pose(self.robot, q), scene)
-            .is_none_or(|(d, ..)| d >= self.options.clearance)
+            .is_none_or(|(d, ..)| d >= self.kept)
     }
 
     fn residual(&mut self, x: &[Real], out: &mut Vec<Real>) -> Option<(ArmState, JointVector)> {
@@ -497,6 +516,18 @@ impl Search<'_> {
         x
     }
 
+    /// [`Self::solve`] keeping `margin` beyond the safety distance, or, where no end has
+    /// that room, the safety distance alone: an end at the safety distance is still better
+    /// than none (a solver may then have to approach it slowly).
+    fn solve_with_room(self, margin: Real) -> Result<OptSolution, OptError> {
+        let mut roomy = self.clone();
+        roomy.kept += margin;
+        match roomy.solve() {
+            Err(OptError::Infeasible) if margin > 0.0 => self.solve(),
+            found => found,
+        }
+    }
+
     fn solve(mut self) -> Result<OptSolution, OptError> {
         let mut starts = self.start_points();
         starts.splice(1..1, self.goal_starts());
@@ -642,10 +673,41 @@ pub fn opt1(
         goals: g2,
         options,
         scene,
+        kept: options.clearance,
         evaluations: 0,
         check_path: true,
     }
-    .solve()
+    .solve_with_room(goal_margin(robot, options.goal_tolerance))
+}
+
+/// The farthest any point of the arm's capsules moves when the state changes within
+/// `tolerance` (m, rad): the position error, plus the rotation error times the arm's
+/// reach from the shoulder (a rotation of Os, Ow or θsw by ε moves a point at distance ρ
+/// from its centre by at most ερ).
+pub fn goal_margin(robot: &Robot, tolerance: (Real, Real)) -> Real {
+    tolerance.0 + tolerance.1 * arm_reach(robot)
+}
+
+/// The farthest a point of the arm's capsules can be from the shoulder in any
+/// configuration: along the chain S -> E -> W -> the point, each leg measured at the zero
+/// configuration (its length does not change where the joint axes meet at S, E and W).
+fn arm_reach(robot: &Robot) -> Real {
+    let pose = arm_pose(robot, &JointVector::zeros());
+    let (upper, fore) = ((pose.elbow - pose.shoulder).norm(), (pose.wrist - pose.elbow).norm());
+    let frame_reach = |frame: usize, p: Vector3| match frame {
+        0..=3 => (p - pose.shoulder).norm(),
+        4 | 5 => upper + (p - pose.elbow).norm(),
+        _ => upper + fore + (p - pose.wrist).norm(),
+    };
+    robot
+        .capsules
+        .iter()
+        .flat_map(|c| {
+            let frame = pose.frames[c.frame.min(DOF)];
+            [frame * nalgebra::Point3::from(c.a), frame * nalgebra::Point3::from(c.b)]
+                .map(|p| frame_reach(c.frame, p.coords) + c.radius)
+        })
+        .fold(upper + fore, Real::max)
 }
 
 fn other(space: Space) -> Space {
@@ -698,8 +760,9 @@ pub fn opt2(
         goals: g,
         options,
         scene,
+        kept: options.clearance,
         evaluations: 0,
         check_path: true,
     }
-    .solve()
+    .solve_with_room(goal_margin(robot, options.goal_tolerance))
 }

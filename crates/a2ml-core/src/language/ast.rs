@@ -468,6 +468,11 @@ pub enum Feature {
         /// Signed angle.
         size: Quantity,
     },
+    /// `arc through [x, y, z]`.
+    Arc {
+        /// The point the arc passes through.
+        through: Vector,
+    },
     /// `hold`.
     Hold,
 }

@@ -99,18 +99,20 @@ impl fmt::Display for Axis {
 }
 
 impl PathFeature {
-    /// The feature's keyword: `line`, `about`, `by` or `hold`.
+    /// The feature's keyword: `line`, `about`, `by`, `arc` or `hold`.
     pub fn keyword(&self) -> &'static str {
         match self {
             PathFeature::Line { .. } => "line",
             PathFeature::About { .. } => "about",
             PathFeature::By { .. } => "by",
+            PathFeature::Arc { .. } => "arc",
             PathFeature::Hold => "hold",
         }
     }
 }
 
-/// `line [..] 0.1 m`, `about r 30 deg`, `by -5 deg`, `hold`; `{:#}` writes `about r, 30 deg`.
+/// `line [..] 0.1 m`, `about r 30 deg`, `by -5 deg`, `arc through [..]` (`to [..]` once the
+/// goal is known), `hold`; `{:#}` writes `about r, 30 deg`.
 impl fmt::Display for PathFeature {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let before = if f.alternate() { ", " } else { " " };
@@ -125,6 +127,13 @@ impl fmt::Display for PathFeature {
             }
             PathFeature::By { angle } => {
                 return write!(f, "by {}", path_size("by", *angle));
+            }
+            PathFeature::Arc { through, to } => {
+                write!(f, "arc through {}", vector(through))?;
+                return match to {
+                    Some(to) => write!(f, " to {}", vector(to)),
+                    None => Ok(()),
+                };
             }
             PathFeature::Hold => return f.write_str("hold"),
         };

@@ -742,6 +742,7 @@ fn feature(feature: &Feature, in_call: bool) -> String {
             format!("about {}{}", axis.text, size(if in_call { ", " } else { " " }, s))
         }
         Feature::By { size } => format!("by {}", quantity(size)),
+        Feature::Arc { through } => format!("arc through {}", vector(through)),
         Feature::Hold => "hold".to_owned(),
     }
 }

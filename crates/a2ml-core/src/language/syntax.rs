@@ -580,6 +580,9 @@ fn feature(node: Node<'_>) -> ast::Feature {
             size: inner.next().map(quantity),
         },
         Rule::by => ast::Feature::By { size: inner.next().map(quantity).expect("by has a size") },
+        Rule::arc => {
+            ast::Feature::Arc { through: inner.next().map(vector).expect("arc has a point") }
+        }
         _ => ast::Feature::Hold,
     }
 }

@@ -219,6 +219,16 @@ pub enum PathFeature {
         /// Angle (rad).
         angle: Real,
     },
+    /// Pw along half an ellipse from where the action starts to `to` through `through`
+    /// (`arc through [..]`, paper §6.3 fig. 12). The action's Pw goal is its end: validation
+    /// moves it here from the goal, which keeps the other variables.
+    Arc {
+        /// The point the arc passes through (m, the task's frame).
+        through: Vector3,
+        /// The arc's end, the action's Pw goal (m, the task's frame); `None` only before
+        /// validation has found the goal.
+        to: Option<Vector3>,
+    },
     /// Kept constant.
     Hold,
 }
@@ -581,7 +591,15 @@ impl Task {
         }
         for action in &mut task.actions {
             match &mut action.body {
-                ActionBody::Constraints { goal, .. } => {
+                ActionBody::Constraints { goal, path, .. } => {
+                    for item in path.iter_mut().flat_map(|p| &mut p.items) {
+                        if let PathFeature::Arc { through, to } = &mut item.feature {
+                            *through += offset;
+                            if let Some(to) = to {
+                                *to += offset;
+                            }
+                        }
+                    }
                     if let Some(g) = goal {
                         shift_targets(&mut g.primary.targets, &offset);
                         if let Some(s) = &mut g.secondary {

@@ -56,6 +56,12 @@ pub enum ProfileError {
         /// Which vector.
         what: &'static str,
     },
+    /// No semi-ellipse runs from the start to the goal through the given point.
+    #[error("no semi-elliptic arc through the point: {reason}")]
+    DegenerateArc {
+        /// Why.
+        reason: &'static str,
+    },
     /// A value contains NaN or infinity.
     #[error("non-finite {what}")]
     NonFinite {

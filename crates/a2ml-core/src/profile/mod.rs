@@ -6,11 +6,13 @@
 //! as (value, velocity) at t; [`WeightSchedule`]. Time t is in s from the start of the primitive
 //! or segment; values and velocities are in {b}, angular velocities spatial (`Ṙ = [ω]× R`).
 
+mod arc;
 mod bell;
 mod error;
 mod reference;
 mod weights;
 
+pub use arc::SemiEllipse;
 pub use bell::BellProfile;
 pub use error::ProfileError;
 pub use reference::{

@@ -1,13 +1,15 @@
 //! The gradient projection method, A2ML's baseline (paper eq. 15-16, METHODS.md §5.2):
 //! q' = J⁺X' + k(I - J⁺J)∇H, J⁺ = Jᵀ(JJᵀ)⁻¹ with J = J_ge, H(q) = -(q - q̄)ᵀ(q - q̄).
 //!
-//! Only the goal hand pose is given to GPM: the wrist follows the straight line to it and Ow
-//! the geodesic rotation, both with the bell profile over the segment; the swivel angle is
-//! left to the null-space term, which pulls every joint towards the middle of its range.
+//! Only the hand's path is given to GPM: in a CPSA segment the wrist follows its Pw reference
+//! (the straight line to the goal, or the path written, e.g. a semi-elliptic `arc`, paper
+//! fig. 12) and Ow its own (the geodesic rotation), both with the bell profile over the
+//! segment; in HAT the straight line to the hand goal. The swivel angle is left to the
+//! null-space term, which pulls every joint towards the middle of its range.
 
 use super::control::{
     ControlError, ControlOptions, ControlRun, HandReference, Resolved, Resolver, Vector6,
-    hand_goal, pose_error, pose_error_score, run,
+    pose_error, pose_error_score, run,
 };
 use super::problem::SegmentProblem;
 use super::report::Tolerance;
@@ -128,8 +130,7 @@ pub fn solve_segment(
     control: &ControlOptions,
 ) -> Result<ControlRun, ControlError> {
     let start = crate::kinematics::arm_pose(robot, q0);
-    let goal = hand_goal(robot, problem)?;
-    let reference = HandReference::straight((start.wrist, start.hand), goal, problem.duration)?;
+    let reference = HandReference::of_segment(robot, problem, (start.wrist, start.hand))?;
     let mut gpm = Gpm::new(robot, reference, *options, control.tolerance);
     run(robot, &mut gpm, q0, problem.duration, control)
 }

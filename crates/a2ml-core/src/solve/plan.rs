@@ -56,7 +56,8 @@ pub struct PlanOptions {
     /// (m), default 0.01: the QP's damper rows, the RRTs' clearance, the swivel map's free
     /// cells, and the start checks.
     pub safety_distance: Real,
-    /// The decomposition (Opt1/Opt2, action planner, default durations).
+    /// The decomposition (Opt1/Opt2, action planner, default durations; Opt1 and Opt2's
+    /// clearance and goal tolerance come from the plan's).
     pub decompose: DecomposeOptions,
     /// The velocity QP (its tolerance and safety distance come from the plan's).
     pub qp: QpOptions,
@@ -277,7 +278,12 @@ pub fn plan_with_progress(
         return Err(SolveError::InvalidAccelerationScale { scale });
     }
     let deadline = options.time_limit.and_then(deadline_after);
-    let decomposition = decompose(robot, task, &options.decompose)?;
+    // The ends Opt1 and Opt2 choose keep the plan's safety distance, with room for its
+    // tolerance.
+    let mut decompose_options = options.decompose.clone();
+    decompose_options.opt.clearance = options.safety_distance;
+    decompose_options.opt.goal_tolerance = (options.tolerance.position, options.tolerance.angle);
+    let decomposition = decompose(robot, task, &decompose_options)?;
     let task_b = task.in_base_frame(&robot.structure.shoulder_in_base_link);
     let close_starts = checks::before_solving(
         robot,
@@ -352,7 +358,8 @@ pub fn plan_with_progress(
     warnings.extend(segments.iter().filter_map(|s| checks::too_close(s, safety)));
     warnings.extend(segments.iter().filter(|s| !s.reached).map(missed));
     warnings.extend(segments.iter().filter(|s| !s.path_kept).map(left_path));
-    warnings.extend(segments.iter().filter(|s| !s.limits_kept).map(over_limits));
+    warnings
+        .extend(segments.iter().filter(|s| !s.limits_kept).map(|s| over_limits(s, robot, &whole)));
     Ok(Plan {
         task: decomposition.task,
         joint_names: robot.joint_names().iter().map(|n| (*n).to_owned()).collect(),
@@ -1210,11 +1217,42 @@ fn describe(e: &VariableError) -> String {
     }
 }
 
-/// The warning for a segment whose output exceeds a joint limit.
-fn over_limits(s: &SegmentReport) -> Warning {
+/// The warning for a segment whose output exceeds a joint limit: the speed ratios, and each
+/// joint whose position passes a limit in the segment's samples, how far.
+fn over_limits(s: &SegmentReport, robot: &Robot, whole: &Trajectory) -> Warning {
+    let (lower, upper) = (robot.lower(), robot.upper());
+    let mut worst = [(0.0, 0.0, 0.0); DOF];
+    for (t, q) in whole.times().iter().zip(whole.positions()) {
+        if *t < s.start || *t > s.end {
+            continue;
+        }
+        for i in 0..DOF {
+            for (excess, limit) in [(lower[i] - q[i], lower[i]), (q[i] - upper[i], upper[i])] {
+                if excess > worst[i].0 {
+                    worst[i] = (excess, q[i], limit);
+                }
+            }
+        }
+    }
+    let passed: Vec<String> = (0..DOF)
+        .filter(|&i| worst[i].0 > 0.0)
+        .map(|i| {
+            let (excess, value, limit) = worst[i];
+            format!(
+                "joint {} `{}` at {:.1}°, {:.1}° past {:.1}°",
+                i + 1,
+                robot.joints[i].name,
+                value.to_degrees(),
+                excess.to_degrees(),
+                limit.to_degrees()
+            )
+        })
+        .collect();
+    let positions =
+        if passed.is_empty() { String::new() } else { format!("; {}", passed.join(", ")) };
     let message = format!(
         "action `{}`, segment {}: exceeds the joint limits (peak |q'|/limit {:.3}, |q''|/limit \
-         {:.3}, or a position limit)",
+         {:.3}{positions})",
         s.action,
         s.segment + 1,
         s.peak_velocity_ratio,

@@ -92,15 +92,21 @@ impl Checker<'_> {
                         format!("action `{}` has neither a goal nor a path", a.name.text),
                     );
                 }
-                let goal = goals.first().map(|g| self.goal(g));
-                let path = paths.first().map(|p| self.path(p));
-                if let (Some(ast_path), Some(Some(pc))) = (paths.first(), &path) {
+                let mut goal = goals.first().map(|g| self.goal(g));
+                let mut path = paths.first().map(|p| self.path(p));
+                if let (Some(ast_path), Some(Some(pc))) = (paths.first(), &mut path) {
                     self.path_against_goal(
                         ast_path,
                         pc,
                         goal.as_ref().and_then(|g| g.as_ref()),
                         goals.is_empty(),
                     );
+                    // A goal with errors of its own says nothing about the arc.
+                    match goal.as_mut() {
+                        Some(goal) if goal.is_none() => {}
+                        Some(goal) => self.arc_to_goal(ast_path, pc, goal),
+                        None => self.arc_to_goal(ast_path, pc, &mut None),
+                    }
                 }
                 let duration = durations.first().map(|d| self.duration(d, "the duration"));
                 ActionBody::Constraints {

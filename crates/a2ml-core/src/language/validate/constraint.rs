@@ -62,6 +62,7 @@ impl Checker<'_> {
             ast::Feature::By { .. } => {
                 (&[Variable::Swivel, Variable::Elbow], "`by` changes θsw or θe")
             }
+            ast::Feature::Arc { .. } => (&[Variable::Pw], "`arc` moves Pw"),
             ast::Feature::Hold => (&Variable::ALL, ""),
         };
         for (v, n) in vars.iter().zip(names) {
@@ -95,6 +96,10 @@ impl Checker<'_> {
                 }
                 PathFeature::By { angle }
             }
+            ast::Feature::Arc { through } => PathFeature::Arc {
+                through: self.vector3(through, Dimension::Length, "the arc's point")?,
+                to: None,
+            },
             ast::Feature::Hold => PathFeature::Hold,
         })
     }
@@ -178,6 +183,10 @@ impl Checker<'_> {
             .map(|(v, _)| *v)
             .collect();
         for (item, ast_item) in path.items.iter().zip(&ast_path.items) {
+            // An arc ends at the goal: it is the way there, not a conflict with it.
+            if matches!(item.feature, PathFeature::Arc { .. }) {
+                continue;
+            }
             for (v, n) in item.variables.iter().zip(&ast_item.variables) {
                 if goal_vars.contains(v) {
                     self.error(
@@ -188,6 +197,43 @@ impl Checker<'_> {
                         ),
                     );
                 }
+            }
+        }
+    }
+}
+
+impl Checker<'_> {
+    /// An `arc` runs from the action's start to its Pw goal: the goal's Pw becomes the arc's
+    /// end and leaves the goal (which keeps its other variables, or goes when it had none).
+    /// The goal must be a single one with Pw in it.
+    pub(super) fn arc_to_goal(
+        &mut self,
+        ast_path: &ast::Path,
+        path: &mut PathConstraint,
+        goal: &mut Option<GoalConstraint>,
+    ) {
+        for (item, ast_item) in path.items.iter_mut().zip(&ast_path.items) {
+            let PathFeature::Arc { to, .. } = &mut item.feature else { continue };
+            let single = goal.as_mut().filter(|g| g.secondary.is_none());
+            let Some(g) =
+                single.filter(|g| g.primary.targets.iter().any(|(v, _)| *v == Variable::Pw))
+            else {
+                self.error(
+                    ast_item.span,
+                    "`arc` runs from the start to the action's Pw goal: give one goal with Pw \
+                     in it (no `>`)",
+                );
+                continue;
+            };
+            let k = g.primary.targets.iter().position(|(v, _)| *v == Variable::Pw);
+            if let Some((_, Target::Position(end))) = k.map(|k| g.primary.targets.remove(k)) {
+                *to = Some(end);
+            }
+            if g.primary.targets.is_empty() {
+                *goal = None;
+            } else if g.primary.targets.iter().all(|(v, _)| *v == Variable::Ow) {
+                // Ow alone belongs to no one space: it takes the path's (classify).
+                g.primary.space = None;
             }
         }
     }

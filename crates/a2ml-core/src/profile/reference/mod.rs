@@ -12,7 +12,7 @@ pub use angle::AngleReference;
 pub use position::{PositionPath, PositionReference};
 pub use rotation::{RotationPath, RotationReference};
 
-use super::{BellProfile, ProfileError};
+use super::{BellProfile, ProfileError, SemiEllipse};
 use crate::language::{Axis, BodyAxis, PathFeature, Target, ValueKind, Variable};
 use crate::math::{Real, Rotation3, Vector3};
 
@@ -207,6 +207,7 @@ impl Reference {
             PathFeature::Line { .. } => "line",
             PathFeature::About { .. } => "about",
             PathFeature::By { .. } => "by",
+            PathFeature::Arc { .. } => "arc",
             PathFeature::Hold => "hold",
         };
         let missing = || ProfileError::MissingSize { variable, feature: keyword };
@@ -225,6 +226,10 @@ impl Reference {
                 let angle = angle.ok_or_else(missing)?;
                 let axis = resolve_axis(&axis, frames)?;
                 Reference::Rotation(RotationReference::about(r, &axis, angle, duration)?)
+            }
+            (PathFeature::Arc { through, to }, Target::Position(p)) => {
+                let arc = SemiEllipse::through(p, to.ok_or_else(missing)?, through)?;
+                Reference::Position(PositionReference::arc(arc, duration)?)
             }
             (PathFeature::By { angle }, Target::Angle(a)) => {
                 Reference::Angle(AngleReference::by(a, angle, variable.wraps(), duration)?)

@@ -1,8 +1,9 @@
-//! The reference of Pw: a line, a turn about an axis through S, or a hold.
+//! The reference of Pw: a line, a turn about an axis through S, a semi-elliptic arc, or a
+//! hold.
 
 use super::{finite_scalar, finite_vector, unit};
-use crate::math::{Real, Vector3, reject, rotation_about};
-use crate::profile::{BellProfile, ProfileError};
+use crate::math::{PI, Real, Vector3, reject, rotation_about};
+use crate::profile::{BellProfile, ProfileError, SemiEllipse};
 
 /// The path of a wrist-position reference.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -20,9 +21,13 @@ pub enum PositionPath {
         /// Unit axis in {b}.
         axis: Vector3,
     },
+    /// Pw along a semi-ellipse from the start to the goal (`arc through`); the distance is
+    /// its eccentric angle, π at the goal.
+    Arc(SemiEllipse),
 }
 
-/// The reference of Pw (m, in {b}): a line, a rotation about an axis through S, or a hold.
+/// The reference of Pw (m, in {b}): a line, a rotation about an axis through S, a
+/// semi-elliptic arc, or a hold.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PositionReference {
     start: Vector3,
@@ -95,6 +100,16 @@ impl PositionReference {
         Ok(Self { start, path: PositionPath::About { axis }, bell })
     }
 
+    /// Pw along the semi-ellipse `arc` from its start to its end, the bell over its
+    /// eccentric angle (0 to π).
+    ///
+    /// # Errors
+    /// An invalid duration.
+    pub fn arc(arc: SemiEllipse, duration: Real) -> Result<Self, ProfileError> {
+        let bell = BellProfile::new(duration, PI)?;
+        Ok(Self { start: arc.start(), path: PositionPath::Arc(arc), bell })
+    }
+
     /// Pw at t = 0 (m, {b}).
     pub fn start(&self) -> Vector3 {
         self.start
@@ -122,12 +137,13 @@ impl PositionReference {
             PositionPath::Hold => (p, Vector3::zeros()),
             PositionPath::Line { direction } => (p, direction * speed),
             PositionPath::About { axis } => (p, axis.cross(&p) * speed),
+            PositionPath::Arc(arc) => (p, arc.tangent(self.bell.progress(t)) * speed),
         }
     }
 
     /// The distance along the path (unbounded, as [`Self::at_distance`]) of the path's point
-    /// nearest to `p`: its projection on a line, its angle about the axis for a rotation (in
-    /// (-π, π]); 0 for a hold.
+    /// nearest to `p`: its projection on a line, its angle about the axis for a rotation, its
+    /// eccentric angle on an arc (both in (-π, π]); 0 for a hold.
     pub fn nearest_distance(&self, p: &Vector3) -> Real {
         match self.path {
             PositionPath::Hold => 0.0,
@@ -136,6 +152,7 @@ impl PositionReference {
                 let (a, b) = (reject(&self.start, &axis), reject(p, &axis));
                 axis.dot(&a.cross(&b)).atan2(a.dot(&b))
             }
+            PositionPath::Arc(arc) => arc.nearest(p),
         }
     }
 
@@ -146,6 +163,7 @@ impl PositionReference {
             PositionPath::Hold => self.start,
             PositionPath::Line { direction } => self.start + direction * s,
             PositionPath::About { axis } => rotation_about(&axis, s) * self.start,
+            PositionPath::Arc(arc) => arc.at(s),
         }
     }
 }
