@@ -1,5 +1,6 @@
 //! The shipped URDFs draw what a2ml collides with: every capsule has a visual cylinder with
-//! its collision's origin and size and two visual spheres at its ends, in the same link.
+//! its collision's origin and size and two visual spheres at its ends, in the same link (a
+//! collision sphere, a capsule of length zero, is drawn as that sphere).
 
 use a2ml::math::{Isometry, Vector3};
 use urdf_rs::Geometry;
@@ -29,6 +30,16 @@ fn every_capsule_is_drawn_as_a_cylinder_and_two_end_spheres() {
             let body = visual("");
             assert_eq!(body.origin.xyz.0, collision.origin.xyz.0, "{name} {}", capsule.name);
             assert_eq!(body.origin.rpy.0, collision.origin.rpy.0, "{name} {}", capsule.name);
+            // A collision sphere is a capsule of length zero: drawn as the sphere it is.
+            if let Geometry::Sphere { radius } = body.geometry {
+                assert_eq!(radius, capsule.radius, "{name} {}", capsule.name);
+                assert!(
+                    (capsule.b - capsule.a).norm() < 1e-12,
+                    "{name}: {} is a sphere",
+                    capsule.name
+                );
+                continue;
+            }
             let Geometry::Cylinder { radius, length } = body.geometry else {
                 panic!("{name}: {} is drawn as a cylinder", capsule.name)
             };

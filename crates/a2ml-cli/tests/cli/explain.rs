@@ -30,7 +30,8 @@ fn temp_task(name: &str, text: &str) -> String {
 
 const TARGET_KEYS: [&str; 8] =
     ["variable", "kind", "text", "position", "quaternion", "rpy_deg", "angle", "angle_deg"];
-const FEATURE_KEYS: [&str; 5] = ["feature", "direction", "axis", "size", "size_deg"];
+const FEATURE_KEYS: [&str; 7] =
+    ["feature", "direction", "axis", "size", "size_deg", "through", "to"];
 
 #[test]
 fn type_i_actions_in_written_order() {

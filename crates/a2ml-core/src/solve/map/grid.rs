@@ -113,16 +113,18 @@ struct Models {
     hand: Vec<Option<CollisionModel>>,
 }
 
-/// `robot` with only the capsules `keep` accepts.
+/// `robot` with only the capsules `keep` accepts, and the self pairs among them (renumbered:
+/// a self pair names capsules by index).
 fn with_capsules(robot: &Robot, keep: impl Fn(usize) -> bool) -> Option<Robot> {
-    let capsules: Vec<_> = robot
-        .capsules
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| keep(*i))
-        .map(|(_, c)| c.clone())
-        .collect();
-    (!capsules.is_empty()).then(|| Robot { capsules, ..robot.clone() })
+    let kept: Vec<usize> = (0..robot.capsules.len()).filter(|&i| keep(i)).collect();
+    if kept.is_empty() {
+        return None;
+    }
+    let index = |old: usize| kept.iter().position(|&k| k == old);
+    let capsules = kept.iter().map(|&i| robot.capsules[i].clone()).collect();
+    let self_pairs =
+        robot.self_pairs.iter().filter_map(|&(a, b)| Some((index(a)?, index(b)?))).collect();
+    Some(Robot { capsules, self_pairs, ..robot.clone() })
 }
 
 impl Models {
