@@ -117,7 +117,7 @@ pub struct ActionReport {
     pub name: String,
     /// Description, if given.
     pub description: Option<String>,
-    /// I to VII; `None` for an explicit action.
+    /// `i` to `vii`; `None` for an explicit action.
     pub action_type: Option<&'static str>,
     /// What the type means.
     pub type_description: String,
@@ -162,7 +162,7 @@ pub struct GoalReport {
 /// A value of one variable; the fields of the other kinds are `None`.
 #[derive(Debug, Serialize)]
 pub struct TargetReport {
-    /// The variable's symbol.
+    /// The variable, in its one spelling (`pw`, `ow`, `swivel`, `shoulder_frame`, `elbow`).
     pub variable: &'static str,
     /// `position`, `rotation` or `angle`.
     pub kind: &'static str,
@@ -249,10 +249,10 @@ pub enum Connection {
 pub struct SegmentReport {
     /// 1-based, as in error messages.
     pub number: usize,
-    /// `CPSA` or `HAT`.
+    /// `cpsa` or `hat`.
     pub space: &'static str,
-    /// 1 (all path), 2 (all goal) or 3 (mixed).
-    pub pattern: u8,
+    /// `path` (all path), `goal` (all goal) or `mixed`.
+    pub pattern: &'static str,
     /// Duration (s).
     pub duration: Real,
     /// Whether the duration was raised for joint velocity limits.
@@ -314,14 +314,15 @@ fn joints_deg(q: &JointVector) -> [Real; DOF] {
     std::array::from_fn(|i| unsigned_zero(deg(q[i])))
 }
 
-fn symbols(variables: &[Variable]) -> Vec<&'static str> {
-    variables.iter().map(|v| v.symbol()).collect()
+/// Variables in their one spelling (docs/cli.md, "Enum values").
+fn spelled(variables: &[Variable]) -> Vec<&'static str> {
+    variables.iter().map(|v| v.as_str()).collect()
 }
 
 impl TargetReport {
     fn new(variable: Variable, target: &Target) -> Self {
         let blank = Self {
-            variable: variable.symbol(),
+            variable: variable.as_str(),
             kind: "",
             text: target.to_string(),
             position: None,
@@ -351,7 +352,7 @@ impl TargetReport {
 impl GoalReport {
     fn new(goal: &Goal) -> Self {
         Self {
-            space: goal.space.map(Space::name),
+            space: goal.space.map(Space::as_str),
             targets: goal.targets.iter().map(|(v, t)| TargetReport::new(*v, t)).collect(),
         }
     }
@@ -392,7 +393,7 @@ impl PrimitiveReport {
             }
             PrimitiveConstraint::Hold => ("hold", Vec::new(), None),
         };
-        Self { constraint, variables: symbols(&p.variables), text: p.to_string(), targets, path }
+        Self { constraint, variables: spelled(&p.variables), text: p.to_string(), targets, path }
     }
 }
 
@@ -405,14 +406,14 @@ impl SegmentReport {
         };
         Self {
             number: k + 1,
-            space: Space::name(s.space),
-            pattern: s.pattern.number(),
+            space: Space::as_str(s.space),
+            pattern: s.pattern.as_str(),
             duration: s.duration,
             duration_raised: s.duration_raised,
             solver: s.solver.name(),
             connection,
             primitives: s.primitives.iter().map(PrimitiveReport::new).collect(),
-            relaxed: symbols(&s.relaxed),
+            relaxed: spelled(&s.relaxed),
             start: joints(&s.start),
             start_deg: joints_deg(&s.start),
             end: joints(&s.end),
@@ -446,14 +447,14 @@ impl ActionReport {
             index: planned.index,
             name: planned.name.clone(),
             description: action.description.clone(),
-            action_type: c.map(|c| c.action_type.numeral()),
+            action_type: c.map(|c| c.action_type.as_str()),
             type_description: c.map_or_else(
                 || "explicit: the segments are written out".to_owned(),
                 |c| c.to_string(),
             ),
-            goal_space: c.and_then(|c| c.goal_space).map(Space::name),
-            secondary_goal_space: c.and_then(|c| c.secondary_goal_space).map(Space::name),
-            path_space: c.and_then(|c| c.path_space).map(Space::name),
+            goal_space: c.and_then(|c| c.goal_space).map(Space::as_str),
+            secondary_goal_space: c.and_then(|c| c.secondary_goal_space).map(Space::as_str),
+            path_space: c.and_then(|c| c.path_space).map(Space::as_str),
             goal: goal.map(|g| GoalConstraintReport {
                 text: g.to_string(),
                 primary: GoalReport::new(&g.primary),
@@ -462,12 +463,12 @@ impl ActionReport {
             path: path.map(|p| PathConstraintReport {
                 text: p.to_string(),
                 hard: p.hard,
-                space: p.space.map(Space::name),
+                space: p.space.map(Space::as_str),
                 items: p
                     .items
                     .iter()
                     .map(|i| PathItemReport {
-                        variables: symbols(&i.variables),
+                        variables: spelled(&i.variables),
                         feature: FeatureReport::new(&i.feature),
                     })
                     .collect(),
@@ -573,9 +574,11 @@ impl ActionReport {
                         .zip(&o.sizes)
                         .filter(|(i, _)| i.feature.feature != "hold")
                         .map(|(i, s)| {
+                            let variables: Vec<&str> =
+                                i.variables.iter().map(|v| symbol(v)).collect();
                             format!(
                                 "{} {} {}",
-                                i.variables.join(" "),
+                                variables.join(" "),
                                 i.feature.feature,
                                 path_size(i.feature.feature, *s)
                             )
@@ -609,8 +612,8 @@ impl SegmentReport {
             Connection::Transitional => "+Tr: overlaps the previous segment",
         };
         let pattern = match self.pattern {
-            1 => "all path",
-            2 => "all goal",
+            "path" => "all path",
+            "goal" => "all goal",
             _ => "path and goal",
         };
         let raised = if self.duration_raised { " (raised for velocity limits)" } else { "" };
@@ -638,7 +641,8 @@ impl SegmentReport {
 
 /// The warning for held variables that had to move.
 fn relaxed(variables: &[&str]) -> String {
-    let (list, it) = match variables {
+    let symbols: Vec<&str> = variables.iter().map(|v| symbol(v)).collect();
+    let (list, it) = match symbols.as_slice() {
         [one] => ((*one).to_owned(), "it"),
         many => (many.join(", "), "them"),
     };
@@ -646,6 +650,12 @@ fn relaxed(variables: &[&str]) -> String {
         "{list} could not be held: with {it} held the end is out of reach within the joint \
          limits, so {it} moves as little as possible (now a goal)"
     )
+}
+
+/// The paper's symbol of a variable given in its spelling (`swivel` -> `θsw`): the text
+/// report reads as A2ML, the JSON carries the spelling.
+fn symbol<'a>(spelling: &'a str) -> &'a str {
+    spelling.parse::<Variable>().map_or(spelling, |v| v.symbol())
 }
 
 /// Indented lines, two spaces per level.

@@ -45,10 +45,10 @@ fn type_i_actions_in_written_order() {
         .collect();
     assert!(at.windows(2).all(|w| w[0] < w[1]), "execution order:\n{text}");
     assert_eq!(text.matches("type I: one path constraint, no goal").count(), 4, "{text}");
-    assert!(text.contains("PC    path θsw by 20 deg, Pw hold, Ow hold : hard  [CPSA]"), "{text}");
+    assert!(text.contains("PC    path θsw by 20 deg, Pw hold, Ow hold : hard  [cpsa]"), "{text}");
     assert!(text.contains("θsw.path(by 20 deg)"), "{text}");
     assert!(text.contains("+Pa Ow.path(about -l, 20 deg)"), "{text}");
-    assert!(text.contains("pattern 1 (all path)"), "{text}");
+    assert!(text.contains("pattern path (all path)"), "{text}");
     assert!(text.contains("+Se: from rest"), "{text}");
 }
 
@@ -59,9 +59,9 @@ fn type_iv_names_opt2() {
     assert!(text.contains("type IV: one goal and a hard path in another space"), "{text}");
     assert!(text.contains("GC    goal Os θe Ow = (rpy("), "{text}");
     assert!(text.contains("96.3 deg"), "{text}");
-    assert!(text.contains("[HAT]") && text.contains("[CPSA]"), "{text}");
+    assert!(text.contains("[hat]") && text.contains("[cpsa]"), "{text}");
     assert!(text.contains("(size left to Opt2)"), "{text}");
-    assert!(text.contains("segment 1  CPSA, pattern 3 (path and goal)"), "{text}");
+    assert!(text.contains("segment 1  cpsa, pattern mixed (path and goal)"), "{text}");
     assert!(text.contains("solver rrt, from the start"), "{text}");
     assert!(text.contains("Pw.path(line [0.3558, 0, 0.9346], "), "{text}");
     assert!(text.contains("+Pa (Ow θsw).goal(rpy("), "{text}");
@@ -110,9 +110,9 @@ fn json_has_the_documented_keys() {
             "optimisations",
         ])
     );
-    assert_eq!(action["action_type"], "IV");
-    assert_eq!(action["goal_space"], "HAT");
-    assert_eq!(action["path_space"], "CPSA");
+    assert_eq!(action["action_type"], "iv");
+    assert_eq!(action["goal_space"], "hat");
+    assert_eq!(action["path_space"], "cpsa");
     assert!(action["secondary_goal_space"].is_null());
 
     let goal = &action["goal"];
@@ -123,10 +123,10 @@ fn json_has_the_documented_keys() {
     for t in targets {
         assert_eq!(keys(t), sorted(TARGET_KEYS.to_vec()));
     }
-    assert_eq!(targets[0]["variable"], "Os");
+    assert_eq!(targets[0]["variable"], "shoulder_frame");
     assert_eq!(targets[0]["kind"], "rotation");
     assert_eq!(targets[0]["quaternion"].as_array().map(Vec::len), Some(4));
-    assert_eq!(targets[1]["variable"], "θe");
+    assert_eq!(targets[1]["variable"], "elbow");
     assert!((targets[1]["angle_deg"].as_f64().expect("deg") - 96.3).abs() < 1e-9);
     assert!(targets[1]["position"].is_null());
 
@@ -162,8 +162,8 @@ fn json_has_the_documented_keys() {
         ])
     );
     assert_eq!(segment["number"], 1);
-    assert_eq!(segment["space"], "CPSA");
-    assert_eq!(segment["pattern"], 3);
+    assert_eq!(segment["space"], "cpsa");
+    assert_eq!(segment["pattern"], "mixed");
     assert_eq!(segment["solver"], "rrt");
     assert_eq!(segment["connection"], "start");
     assert!(segment["duration"].as_f64().expect("duration") > 0.0);
@@ -174,7 +174,7 @@ fn json_has_the_documented_keys() {
     assert_eq!(primitives[0]["constraint"], "path");
     assert_eq!(keys(&primitives[0]["path"]), sorted(FEATURE_KEYS.to_vec()));
     assert_eq!(primitives[1]["constraint"], "goal");
-    assert_eq!(primitives[1]["variables"], serde_json::json!(["Ow", "θsw"]));
+    assert_eq!(primitives[1]["variables"], serde_json::json!(["ow", "swivel"]));
 
     let opts = action["optimisations"].as_array().expect("optimisations");
     assert_eq!(opts.len(), 1);
@@ -192,7 +192,7 @@ fn json_of_type_i_connects_actions_sequentially() {
     let actions = json["actions"].as_array().expect("actions");
     assert_eq!(actions.len(), 4);
     for (i, a) in actions.iter().enumerate() {
-        assert_eq!(a["action_type"], "I");
+        assert_eq!(a["action_type"], "i");
         assert_eq!(a["index"], i);
         assert!(a["goal"].is_null());
         assert_eq!(a["optimisations"], serde_json::json!([]));
