@@ -49,7 +49,7 @@ def test_bad_obstacles_and_blocked_ends_raise() -> None:
     with pytest.raises(ValueError, match="radius"):
         a2ml.scene_clearance(robot, [{"type": "sphere", "position": [1, 0, 0]}], p["start"])
     with pytest.raises(TypeError):
-        a2ml.scene_clearance(robot, [3], p["start"])
+        a2ml.scene_clearance(robot, [3], p["start"])  # type: ignore[list-item]
     # A ball around the whole arm: the start is not clear.
     ball = [{"type": "sphere", "position": [0, 0, 0.5], "radius": 2.0}]
     with pytest.raises(a2ml.PlanError, match="start"):

@@ -47,6 +47,8 @@ __all__ = [
     "decompose",
     "plan",
     "plan_many",
+    "rrt_connect",
+    "scene_clearance",
     "Plan",
     "SegmentReport",
     "A2mlError",
