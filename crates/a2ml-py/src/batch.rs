@@ -16,7 +16,7 @@ use numpy::{
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
-use crate::convert::{read_joints, rotation_from, shape_text};
+use crate::convert::{not_numbers, read_joints, rotation_from, shape_text};
 use crate::errors::CoreError;
 use crate::robot::PyRobot;
 
@@ -54,18 +54,9 @@ fn batch_shape_text(row: &[usize]) -> String {
 /// The rows of `value`, which must have shape (N, *row) and finite entries; the error names
 /// the argument and, for a non-finite entry, its row.
 fn read_rows<'py>(value: &Bound<'py, PyAny>, name: &str, row: &[usize]) -> PyResult<Rows<'py>> {
-    let like = value.extract::<PyArrayLikeDyn<'py, Real, AllowTypeChange>>().map_err(|e| {
-        let message = format!(
-            "{name} must be an array of numbers of shape {}: {}",
-            batch_shape_text(row),
-            e.value(value.py())
-        );
-        if e.is_instance_of::<PyTypeError>(value.py()) {
-            PyTypeError::new_err(message)
-        } else {
-            PyValueError::new_err(message)
-        }
-    })?;
+    let like = value
+        .extract::<PyArrayLikeDyn<'py, Real, AllowTypeChange>>()
+        .map_err(|e| not_numbers(value, name, &batch_shape_text(row), &e))?;
     let shape = like.shape();
     if shape.len() != row.len() + 1 || shape[1..] != *row {
         return Err(PyValueError::new_err(format!(

@@ -32,18 +32,9 @@ pub(crate) fn read_array(
     name: &str,
     shape: &[usize],
 ) -> PyResult<Vec<Real>> {
-    let array = value.extract::<PyArrayLikeDyn<'_, Real, AllowTypeChange>>().map_err(|e| {
-        let message = format!(
-            "{name} must be an array of numbers of shape {}: {}",
-            shape_text(shape),
-            e.value(value.py())
-        );
-        if e.is_instance_of::<PyTypeError>(value.py()) {
-            PyTypeError::new_err(message)
-        } else {
-            PyValueError::new_err(message)
-        }
-    })?;
+    let array = value
+        .extract::<PyArrayLikeDyn<'_, Real, AllowTypeChange>>()
+        .map_err(|e| not_numbers(value, name, &shape_text(shape), &e))?;
     if array.shape() != shape {
         return Err(PyValueError::new_err(format!(
             "{name} must have shape {}, got {}",
@@ -134,5 +125,17 @@ pub(crate) fn to_solutions<'py>(
     } else {
         // The core returns at least one solution or an error; nearest first.
         to_vector(py, solutions.first().map(|q| q.as_slice()).unwrap_or(&[])).into_any()
+    }
+}
+
+/// The error for `value` that numpy could not read as an array of numbers of `shape` (its
+/// text): a `TypeError` where numpy raised one (not array-like at all), else a `ValueError`.
+pub(crate) fn not_numbers(value: &Bound<'_, PyAny>, name: &str, shape: &str, e: &PyErr) -> PyErr {
+    let message =
+        format!("{name} must be an array of numbers of shape {shape}: {}", e.value(value.py()));
+    if e.is_instance_of::<PyTypeError>(value.py()) {
+        PyTypeError::new_err(message)
+    } else {
+        PyValueError::new_err(message)
     }
 }
