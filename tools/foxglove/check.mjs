@@ -73,6 +73,9 @@ function resolveFile(table, urlPath) {
   return undefined;
 }
 
+// Paths the viewer asked for that the server does not have, for the console log.
+const notFound = [];
+
 // Serves the files with range requests (Foxglove's remote MCAP reader asks for
 // byte ranges) and CORS, on 127.0.0.1 at a free port.
 function serve(options) {
@@ -87,6 +90,7 @@ function serve(options) {
       size = undefined;
     }
     if (size === undefined) {
+      notFound.push(urlPath);
       response.writeHead(404).end();
       return;
     }
@@ -145,11 +149,16 @@ async function view(page, options, panels) {
   await threeDee.locator("canvas").first().waitFor({ timeout: 180000 });
   // The first-run hint over the 3D panel's toolbar.
   const hint = page.getByText("Open settings to configure topics and layers.");
-  if (await hint.isVisible()) await hint.locator("..").getByRole("button").click();
+  // A dispatched click: the hint fades in, and under load it may never look stable.
+  if (await hint.isVisible()) {
+    await hint.locator("..").getByRole("button", { name: "Dismiss" }).dispatchEvent("click");
+  }
   const slider = page.locator('[class*="-Slider-root"]').first();
   for (const fraction of [0.02, 0.35, 0.75, 0.99]) {
     const box = await slider.boundingBox();
     await slider.click({ position: { x: box.width * fraction, y: box.height / 2 } });
+    // Away from the slider, whose hover label would cover the panels.
+    await page.mouse.move(box.x + box.width / 2, box.y - 300);
     await page.waitForTimeout(SETTLE_MS);
     const name = `t${String(Math.round(fraction * 100)).padStart(2, "0")}`;
     await page.screenshot({ path: join(options.out, `window-${name}.png`), ...SCREENSHOT });
@@ -159,7 +168,24 @@ async function view(page, options, panels) {
   await threeDee.getByTestId("SettingsIcon").first().click();
   await page.waitForTimeout(SETTLE_MS);
   await page.screenshot({ path: join(options.out, "3d-settings.png"), ...SCREENSHOT });
-  writeFileSync(join(options.out, "3d-settings.txt"), await page.locator("body").innerText());
+  const settings = await page.locator("body").innerText();
+  writeFileSync(join(options.out, "3d-settings.txt"), settings);
+  return settings;
+}
+
+// What a run must show: every topic the layout's 3D panel names listed in its
+// settings (Foxglove found it in the MCAP), and no uncaught error in the page.
+function problems(layoutFile, settings, console) {
+  const found = [];
+  const configs = JSON.parse(readFileSync(layoutFile, "utf8")).configById;
+  for (const [id, config] of Object.entries(configs)) {
+    if (!id.startsWith("3D!")) continue;
+    for (const topic of Object.keys(config.topics ?? {})) {
+      if (!settings.split("\n").includes(topic)) found.push(`${id}: topic ${topic} not in the 3D settings`);
+    }
+  }
+  found.push(...console.filter((line) => line.startsWith("[pageerror]")));
+  return found;
 }
 
 async function main() {
@@ -175,6 +201,7 @@ async function main() {
     args: ["--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist"],
   });
   const console = [];
+  const failures = [];
   try {
     const page = await browser.newPage({ viewport: { width: 1600, height: 1000 } });
     page.on("console", (message) => console.push(`[${message.type()}] ${message.text()}`));
@@ -186,13 +213,19 @@ async function main() {
     await page.addInitScript(() => {
       window.localStorage.setItem("studio.profile-data", JSON.stringify({ currentLayoutId: "a2ml" }));
     });
-    await page.goto(url);
-    await view(page, options, layoutPanels(options.layout));
+    await page.goto(url, { timeout: 180000 });
+    const settings = await view(page, options, layoutPanels(options.layout));
+    failures.push(...problems(options.layout, settings, console));
   } finally {
-    writeFileSync(join(options.out, "console.log"), console.join("\n") + "\n");
+    const served = notFound.map((path) => `[server 404] ${path}`);
+    writeFileSync(join(options.out, "console.log"), [...console, ...served].join("\n") + "\n");
     await browser.close();
     server.close();
   }
+  if (failures.length > 0) {
+    throw new Error(`the viewer did not show the plan as the layout asks:\n${failures.join("\n")}`);
+  }
+  process.stdout.write(`ok: screenshots and console log in ${options.out}\n`);
 }
 
 main().catch((error) => {
