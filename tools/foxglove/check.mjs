@@ -153,7 +153,9 @@ async function view(page, options, panels) {
   if (await hint.isVisible()) {
     await hint.locator("..").getByRole("button", { name: "Dismiss" }).dispatchEvent("click");
   }
-  const slider = page.locator('[class*="-Slider-root"]').first();
+  // The playback slider is disabled until the MCAP's summary is read.
+  const slider = page.locator('[class*="-Slider-root"]:not([class*="rootDisabled"])').first();
+  await slider.waitFor({ timeout: 180000 });
   for (const fraction of [0.02, 0.35, 0.75, 0.99]) {
     const box = await slider.boundingBox();
     await slider.click({ position: { x: box.width * fraction, y: box.height / 2 } });
