@@ -29,6 +29,22 @@ fn expect_error(name: &str, line: usize, column: usize, message: &str) {
     assert!(found, "{name}: no error at {line}:{column} containing {message:?}; got:\n{rendered}");
     assert!(rendered.contains(&format!("{name}.a2ml:{line}:{column}")), "{rendered}");
     assert!(rendered.contains('^'), "{rendered}");
+    snapshot_rendered(name, &rendered);
+}
+
+/// The whole rendering (every error, its location, caret and help) against
+/// `snapshots/malformed/<name>.snap`, with the checkout's folder written
+/// `[repo]` so that the snapshot holds on any machine. A mismatch fails the
+/// test; `cargo insta review` (or `INSTA_UPDATE=always`) accepts a new one.
+fn snapshot_rendered(name: &str, rendered: &str) {
+    let portable = rendered.replace(env!("CARGO_MANIFEST_DIR"), "[repo]");
+    insta::with_settings!({
+        snapshot_path => "snapshots/malformed",
+        prepend_module_to_snapshot => false,
+        omit_expression => true,
+    }, {
+        insta::assert_snapshot!(name, portable);
+    });
 }
 
 macro_rules! malformed {

@@ -85,11 +85,15 @@ pub struct ArmArgs {
     /// without usable URDF geometry; 0 leaves them uncovered [default: 0.06].
     #[arg(long, value_name = "M")]
     pub skeleton_radius: Option<f64>,
+    /// An SRDF whose `<disable_collisions>` pairs are not checked for self-collision
+    /// [default: the URDF's name with `.srdf`, when that file exists].
+    #[arg(long, value_name = "PATH")]
+    pub srdf: Option<std::path::PathBuf>,
 }
 
 impl ArmArgs {
     /// The robot options: `--base`/`--tip` (a task's own `base`/`tip` come second, in
-    /// [`a2ml_core::language::Task::load_robot`]), and the package path with the
+    /// [`a2ml_core::language::Task::load_robot`]), `--srdf`, and the package path with the
     /// environment's folders after `--package-path`.
     ///
     /// # Errors
@@ -102,6 +106,7 @@ impl ArmArgs {
         };
         let geometry = &mut options.geometry;
         geometry.package_path = self.package_path.clone();
+        geometry.srdf = self.srdf.clone();
         for variable in ["A2ML_PACKAGE_PATH", "ROS_PACKAGE_PATH"] {
             if let Some(value) = std::env::var_os(variable) {
                 geometry.package_path.extend(std::env::split_paths(&value));

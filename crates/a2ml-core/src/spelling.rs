@@ -57,11 +57,13 @@ pub struct UnknownSpelling {
     pub expected: String,
 }
 
-/// `as_str`, `Display` and `FromStr` of a [`Spelled`] enum from its serde spelling.
+/// `as_str`, `Display` and `FromStr` of a [`Spelled`] enum from its serde spelling, its
+/// values listed in brackets or named by the enum's own array of them (`Variable::ALL`), so
+/// that the list is written once.
 macro_rules! spelled {
-    ($type:ty, $what:literal, [$($value:expr),+ $(,)?]) => {
+    (@impl $type:ty, $what:literal, $all:expr) => {
         impl $crate::spelling::Spelled for $type {
-            const ALL: &'static [Self] = &[$($value),+];
+            const ALL: &'static [Self] = &$all;
             const WHAT: &'static str = $what;
         }
 
@@ -85,6 +87,12 @@ macro_rules! spelled {
                 $crate::spelling::parse(text)
             }
         }
+    };
+    ($type:ty, $what:literal, [$($value:expr),+ $(,)?]) => {
+        $crate::spelling::spelled!(@impl $type, $what, [$($value),+]);
+    };
+    ($type:ty, $what:literal, $all:path) => {
+        $crate::spelling::spelled!(@impl $type, $what, $all);
     };
 }
 pub(crate) use spelled;

@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use a2ml_core::language::{
     self, Action, ActionBody, Axis, Goal, GoalConstraint, Obstacle, PathConstraint, PathFeature,
     PathItem, PositionFrame, Primitive, PrimitiveConstraint, Segment, Settings, Shape,
-    SolverChoice, Space, Start, Target, Variable,
+    SolverChoice, Space, Start, Target, ValueKind, Variable,
 };
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -142,12 +142,10 @@ impl PyTask {
                     a2ml_core::spelling::spellings::<Variable>().join(", ")
                 ))
             })?;
-            let target = match variable {
-                Variable::Pw => Target::Position(read_vector3(&value, &name)?),
-                Variable::Ow | Variable::Os => Target::Rotation(read_rotation(&value, &name)?),
-                Variable::Swivel | Variable::Elbow => {
-                    Target::Angle(read_angle(value.extract()?, &name)?)
-                }
+            let target = match variable.kind() {
+                ValueKind::Position => Target::Position(read_vector3(&value, &name)?),
+                ValueKind::Rotation => Target::Rotation(read_rotation(&value, &name)?),
+                ValueKind::Angle => Target::Angle(read_angle(value.extract()?, &name)?),
             };
             goals.push((variable, target));
         }

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use clap::Args;
 
 use a2ml_core::RobotOptions;
-use a2ml_core::language::{SolverChoice, Variable};
+use a2ml_core::language::{Measure, SolverChoice, Variable};
 use a2ml_core::output as files;
 use a2ml_core::solve::compare::{ComparisonRecord, compare, records};
 use a2ml_core::solve::{PlanOptions, Tolerance};
@@ -114,11 +114,13 @@ fn table(rows: &[ComparisonRecord], tolerance: &Tolerance) -> String {
             .errors
             .iter()
             .map(|(v, e)| {
-                if v == Variable::Pw.as_str() {
-                    format!("{v} {} mm", num(e * 1e3, 1))
-                } else {
-                    format!("{v} {}°", num(deg(*e), 2))
-                }
+                // The records name each variable by its one spelling.
+                let measure = v.parse().map_or(Measure::Angle, Variable::measure);
+                let decimals = match measure {
+                    Measure::Length => 1,
+                    Measure::Angle => 2,
+                };
+                format!("{v} {}{}", num(measure.shown(*e), decimals), measure.shown_unit())
             })
             .collect();
         let path = match r.path_kept {
@@ -149,8 +151,8 @@ fn table(rows: &[ComparisonRecord], tolerance: &Tolerance) -> String {
     t.render(&mut out);
     out.push_str(&format!(
         "  reached: within {} mm and {}°; a negative margin or clearance is a violation\n",
-        num(tolerance.position * 1e3, 1),
-        num(deg(tolerance.angle), 1)
+        num(Measure::Length.shown(tolerance.position), 1),
+        num(Measure::Angle.shown(tolerance.angle), 1)
     ));
     out
 }

@@ -499,13 +499,7 @@ fn goal_error(s: &SegmentReport, tolerance: &Tolerance) -> String {
         .errors
         .iter()
         .max_by(|a, b| (a.error / limit(a.variable)).total_cmp(&(b.error / limit(b.variable))));
-    match worst {
-        Some(e) if e.variable == Variable::Pw => {
-            format!("{} {} mm", e.variable, num(e.error * 1e3, 2))
-        }
-        Some(e) => format!("{} {}°", e.variable, num(deg(e.error), 2)),
-        None => "-".to_owned(),
-    }
+    worst.map_or_else(|| "-".to_owned(), |e| e.variable.error_text(e.error, 2))
 }
 
 /// `ok`, `stalled` (stopped making progress short of the goal), `missed`

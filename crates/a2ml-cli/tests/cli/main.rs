@@ -49,6 +49,17 @@ fn a2ml(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_a2ml")).args(args).output().expect("the binary runs")
 }
 
+/// Runs the binary in the repository's root, so that a file named from there
+/// (`examples/…`) prints the same on every machine, as a snapshot needs.
+fn a2ml_in_repo(args: &[&str]) -> Output {
+    let root: PathBuf = [env!("CARGO_MANIFEST_DIR"), "..", ".."].iter().collect();
+    Command::new(env!("CARGO_BIN_EXE_a2ml"))
+        .args(args)
+        .current_dir(root)
+        .output()
+        .expect("the binary runs")
+}
+
 fn stdout(output: &Output) -> String {
     String::from_utf8(output.stdout.clone()).expect("UTF-8 stdout")
 }

@@ -6,7 +6,7 @@ use std::process::Command;
 
 use serde_json::Value;
 
-use crate::{a2ml, example_path, fixture, scratch, stderr, stdout};
+use crate::{a2ml, a2ml_in_repo, example_path, fixture, scratch, stderr, stdout};
 
 /// The first bytes of every MCAP file.
 const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
@@ -105,6 +105,26 @@ fn writes_mcap_csv_and_json() {
     assert!(segments.iter().all(|s| s["reached"] == true));
     assert_eq!(plan["warnings"], serde_json::json!([]));
     assert_eq!(plan["trajectory"]["times"].as_array().expect("times").len(), samples);
+}
+
+/// The whole summary of a few examples against its snapshot in `snapshots/`,
+/// the planning time (the clock's, different on every run) and the scratch
+/// folder redacted, every other figure kept.
+#[test]
+fn summary_matches_its_snapshot() {
+    let dir = scratch("plan", "summary_matches_its_snapshot");
+    let folder = dir.to_string_lossy().into_owned();
+    for example in ["construct_path_line", "construct_strips", "type_vi_elbow_hold"] {
+        let mcap = path_in(&dir, &format!("{example}.mcap"));
+        let output = a2ml_in_repo(&["plan", &format!("examples/{example}.a2ml"), "-o", &mcap]);
+        assert_eq!(output.status.code(), Some(0), "{example}: {}", stderr(&output));
+        let text = stdout(&output).replace(&folder, "[scratch]");
+        insta::with_settings!({
+            filters => vec![(r"planned in \d+\.\d+ s", "planned in [seconds] s")],
+        }, {
+            insta::assert_snapshot!(example, text);
+        });
+    }
 }
 
 #[test]

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use serde_json::Value;
 
-use crate::{a2ml, keys, robot_path, sorted, stderr, stdout};
+use crate::{a2ml, example_path, keys, robot_path, scratch, sorted, stderr, stdout};
 
 /// A regular iiwa14 configuration within the limits whose feasible swivel
 /// angles form proper intervals (not the whole circle).
@@ -256,6 +256,46 @@ fn missing_file_exits_1() {
     assert_eq!(output.status.code(), Some(1));
     assert!(stderr(&output).starts_with("error: "), "{}", stderr(&output));
     assert!(stdout(&output).is_empty());
+}
+
+/// `--srdf` is the SRDF read by `robot` and `plan`: a valid one loads, one naming a link
+/// the URDF lacks or that cannot be read is refused with its path (exit 2), as the SRDF
+/// beside a URDF is.
+#[test]
+fn srdf_flag_names_the_srdf_read() {
+    let dir = scratch("robot", "srdf_flag_names_the_srdf_read");
+    let good = dir.join("pairs.srdf");
+    std::fs::write(
+        &good,
+        "<robot name=\"panda\">\n  <disable_collisions link1=\"hand\" link2=\"panda_link3\" \
+         reason=\"Never\"/>\n</robot>\n",
+    )
+    .expect("SRDF written");
+    let bad = dir.join("bad.srdf");
+    std::fs::write(
+        &bad,
+        "<robot>\n\n  <disable_collisions link1=\"hand\" link2=\"panda_link33\"/>\n</robot>",
+    )
+    .expect("SRDF written");
+    let panda = robot_path("panda.urdf");
+    let output = a2ml(&["robot", &panda, "--srdf", &good.to_string_lossy()]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+
+    let output = a2ml(&["robot", &panda, "--srdf", &bad.to_string_lossy()]);
+    assert_eq!(output.status.code(), Some(2));
+    let err = stderr(&output);
+    assert!(err.contains(&format!("{}: line 3: invalid SRDF", bad.display())), "{err}");
+    assert!(err.contains("`panda_link33`"), "{err}");
+
+    let missing = dir.join("missing.srdf");
+    let task = example_path("construct_minimal.a2ml");
+    let plan = dir.join("plan.mcap");
+    let output =
+        a2ml(&["plan", &task, "-o", &plan.to_string_lossy(), "--srdf", &missing.to_string_lossy()]);
+    assert_eq!(output.status.code(), Some(2));
+    let err = stderr(&output);
+    assert!(err.contains(&format!("{}: invalid SRDF", missing.display())), "{err}");
+    assert!(!plan.exists(), "nothing is planned with an SRDF that cannot be read");
 }
 
 #[test]

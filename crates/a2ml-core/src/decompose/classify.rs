@@ -93,19 +93,7 @@ impl ActionType {
     }
 }
 
-spelled!(
-    ActionType,
-    "action type",
-    [
-        ActionType::I,
-        ActionType::II,
-        ActionType::III,
-        ActionType::IV,
-        ActionType::V,
-        ActionType::VI,
-        ActionType::VII,
-    ]
-);
+spelled!(ActionType, "action type", ActionType::ALL);
 
 /// An action's type with the space each of its constraints is placed in
 /// (Ow-only constraints placed as the module documents).

@@ -144,10 +144,10 @@ mod tests {
     #[test]
     fn a_missing_action_or_goal_is_named() {
         let pw = [(Variable::Pw, Target::Position(Vector3::zeros()))];
-        let err = with_goal(&source(), None, "fetch", &pw).unwrap_err();
+        let err = with_goal(&source(), None, "fetch", &pw).expect_err("no such action");
         assert_eq!(err.to_string(), "the task has no action `fetch` (actions: reach, back)");
         let elbow = [(Variable::Elbow, Target::Angle(1.0))];
-        let err = with_goal(&source(), None, "back", &elbow).unwrap_err();
+        let err = with_goal(&source(), None, "back", &elbow).expect_err("no goal");
         assert!(matches!(err, EditError::NoGoal { .. }), "{err}");
     }
 }

@@ -17,6 +17,7 @@ mod syntax;
 mod task;
 mod validate;
 mod variable;
+pub use variable::Measure;
 
 use std::path::Path;
 

@@ -9,11 +9,7 @@ use crate::robot::{Robot, RobotError, RobotOptions};
 use crate::spelling::spelled;
 
 spelled!(Space, "space", [Space::Cpsa, Space::Hat]);
-spelled!(
-    Variable,
-    "variable",
-    [Variable::Pw, Variable::Ow, Variable::Swivel, Variable::Os, Variable::Elbow]
-);
+spelled!(Variable, "variable", Variable::ALL);
 spelled!(
     SolverChoice,
     "solver",

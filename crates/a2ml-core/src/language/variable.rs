@@ -1,12 +1,66 @@
 //! The rules of the five state variables (Pw, Ow, θsw, Os, θe) that every stage asks
 //! instead of deciding again: how many rows a variable takes, that θsw wraps and θe does
 //! not, the difference and distance between two values, and the body axes read from a
-//! frame. Names, spaces and kinds are on [`Variable`] beside its definition.
+//! frame, what its errors measure (their default tolerance and the unit a user reads them
+//! in). Names, spaces and kinds are on [`Variable`] beside its definition.
 
 use super::task::{BodyAxis, Target, ValueKind, Variable};
 use crate::math::{Real, Vector3, rotation_distance, rotation_log, wrap_angle};
 
+/// What a variable's errors measure: a length (Pw, in m) or an angle (the geodesic angle of
+/// a rotation, or an angle's difference, in rad). A goal tolerance is one per measure.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Measure {
+    /// Metres, shown in millimetres.
+    Length,
+    /// Radians, shown in degrees.
+    Angle,
+}
+
+impl Measure {
+    /// The default goal tolerance: 1 mm for a length, 1° for an angle.
+    pub fn default_tolerance(self) -> Real {
+        match self {
+            Measure::Length => 1e-3,
+            Measure::Angle => 1.0_f64.to_radians(),
+        }
+    }
+
+    /// `value` (m or rad) in the unit a user reads it in: mm or degrees.
+    pub fn shown(self, value: Real) -> Real {
+        match self {
+            Measure::Length => value * 1e3,
+            Measure::Angle => value.to_degrees(),
+        }
+    }
+
+    /// The shown unit as it follows a number: ` mm` (spaced) or `°` (not).
+    pub fn shown_unit(self) -> &'static str {
+        match self {
+            Measure::Length => " mm",
+            Measure::Angle => "°",
+        }
+    }
+}
+
 impl Variable {
+    /// What the variable's errors measure: a length for Pw, an angle for the rotations and
+    /// the angles.
+    pub fn measure(self) -> Measure {
+        match self.kind() {
+            ValueKind::Position => Measure::Length,
+            ValueKind::Rotation | ValueKind::Angle => Measure::Angle,
+        }
+    }
+
+    /// An error of the variable as a user reads it, `decimals` shown: `pw 0.42 mm`,
+    /// `swivel 0.31°`.
+    pub fn error_text(self, error: Real, decimals: usize) -> String {
+        let measure = self.measure();
+        // + 0.0 turns -0 into 0, so no `-0.00` is shown.
+        format!("{self} {:.decimals$}{}", measure.shown(error) + 0.0, measure.shown_unit())
+    }
+
     /// Whether the variable's value is an angle taken modulo a turn: θsw is (an arm plane
     /// half a turn round is the same plane reached the other way), θe is not (it is fixed
     /// in [0, π] by the arm triangle, so its plain difference is the motion).
@@ -127,5 +181,16 @@ mod tests {
         }
         assert_eq!(Variable::Swivel.body_axes(), None);
         assert_eq!(BodyAxis::P.name(), "p");
+    }
+
+    #[test]
+    fn errors_measure_a_length_for_pw_and_an_angle_otherwise() {
+        let lengths: Vec<Variable> =
+            Variable::ALL.into_iter().filter(|v| v.measure() == Measure::Length).collect();
+        assert_eq!(lengths, [Variable::Pw]);
+        assert_eq!(Measure::Length.default_tolerance(), 1e-3);
+        assert!((Measure::Angle.shown(Measure::Angle.default_tolerance()) - 1.0).abs() < 1e-12);
+        assert_eq!(Variable::Pw.error_text(0.42e-3, 2), "pw 0.42 mm");
+        assert_eq!(Variable::Swivel.error_text(0.31_f64.to_radians(), 2), "swivel 0.31°");
     }
 }

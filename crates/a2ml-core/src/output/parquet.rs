@@ -76,7 +76,7 @@ fn columns(robot: &Robot, task: &Task, plan: &Plan, task_id: &str) -> Vec<(Strin
     let scenes: Vec<CollisionScene> =
         (0..task_b.actions.len()).map(|a| CollisionScene::new(&task_b.action_scene(a))).collect();
 
-    let mut wrist = vec![Vec::with_capacity(samples); 7];
+    let mut wrist: Vec<Vec<_>> = (0..7).map(|_| Vec::with_capacity(samples)).collect();
     let mut swivel = Vec::with_capacity(samples);
     let mut clearance = Vec::with_capacity(samples);
     for (q, &segment) in plan.trajectory.positions().iter().zip(&segments) {

@@ -15,7 +15,7 @@ use super::OutputError;
 use super::plot::{Panel, PlotData, PlotError, PlotKind, plot_data_svg};
 use crate::collision::arm_capsules;
 use crate::kinematics::arm_pose;
-use crate::language::{Obstacle, Task, Variable};
+use crate::language::{Obstacle, Task};
 use crate::math::{Real, Vector3};
 use crate::metrics::{self, MetricsOptions, ScoreSummary, Span, SpanMetrics};
 use crate::robot::Robot;
@@ -209,15 +209,6 @@ fn number_cell(value: Real, decimals: usize) -> String {
     format!("<td class=\"n\" data-value=\"{value:?}\">{}</td>", fixed(value, decimals))
 }
 
-/// One error as `pw 0.42 mm` or `swivel 0.31°`.
-fn error_text(variable: Variable, error: Real) -> String {
-    if variable == Variable::Pw {
-        format!("{variable} {} mm", fixed(error * 1e3, 2))
-    } else {
-        format!("{variable} {}°", fixed(error.to_degrees(), 2))
-    }
-}
-
 /// The per-segment table, one row per segment.
 pub fn segments_table(out: &mut String, segments: &[SegmentReport]) {
     out.push_str(
@@ -229,7 +220,7 @@ pub fn segments_table(out: &mut String, segments: &[SegmentReport]) {
     );
     for s in segments {
         let errors: Vec<String> =
-            s.errors.iter().map(|e| error_text(e.variable, e.error)).collect();
+            s.errors.iter().map(|e| e.variable.error_text(e.error, 2)).collect();
         let clearance = s.clearance.as_ref().map_or_else(
             || "<td class=\"n\">-</td>".to_owned(),
             |c| number_cell(c.distance * 1e3, 1),

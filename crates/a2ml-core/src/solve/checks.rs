@@ -81,8 +81,24 @@ pub enum CheckError {
     },
 }
 
+/// What a decomposed task is checked against before solving: the plan's settings.
+#[derive(Debug, Clone, Copy)]
+pub struct Bounds<'a> {
+    /// The output rate (Hz).
+    pub rate: Real,
+    /// The control rate (Hz).
+    pub control_rate: Real,
+    /// The safety distance every action's start keeps (m).
+    pub safety: Real,
+    /// How much one task may ask for.
+    pub limits: &'a Limits,
+    /// Whether a start closer than `safety` is a warning rather than an error.
+    pub allow_close_start: bool,
+}
+
 /// Checks the decomposition of `task` (in {b}) before any segment is solved. A start too
-/// close is an error unless `allow_close_start`, when it is returned as a warning instead.
+/// close is an error unless `bounds.allow_close_start`, when it is returned as a warning
+/// instead.
 ///
 /// # Errors
 /// The first [`CheckError`].
@@ -90,12 +106,9 @@ pub fn before_solving(
     robot: &Robot,
     task: &Task,
     decomposition: &Decomposition,
-    rate: Real,
-    control_rate: Real,
-    safety: Real,
-    limits: &Limits,
-    allow_close_start: bool,
+    bounds: &Bounds<'_>,
 ) -> Result<Vec<Warning>, CheckError> {
+    let Bounds { rate, control_rate, safety, limits, allow_close_start } = *bounds;
     let segments: usize = decomposition.actions.iter().map(|a| a.segments.len()).sum();
     if segments > limits.max_segments {
         return Err(CheckError::TooManySegments { segments, limit: limits.max_segments });

@@ -285,16 +285,14 @@ pub fn plan_with_progress(
     decompose_options.opt.goal_tolerance = (options.tolerance.position, options.tolerance.angle);
     let decomposition = decompose(robot, task, &decompose_options)?;
     let task_b = task.in_base_frame(&robot.structure.shoulder_in_base_link);
-    let close_starts = checks::before_solving(
-        robot,
-        &task_b,
-        &decomposition,
+    let bounds = checks::Bounds {
         rate,
-        1.0 / options.qp.step,
-        options.safety_distance,
-        &options.limits,
-        options.allow_close_start,
-    )?;
+        control_rate: 1.0 / options.qp.step,
+        safety: options.safety_distance,
+        limits: &options.limits,
+        allow_close_start: options.allow_close_start,
+    };
+    let close_starts = checks::before_solving(robot, &task_b, &decomposition, &bounds)?;
     let total = decomposition.actions.iter().map(|a| a.segments.len()).sum();
     let mut state = Solver {
         robot,

@@ -28,10 +28,7 @@ pub struct SegmentProblem {
     pub duration: Real,
 }
 
-/// Rows of a variable in its space's Jacobian: 3 for positions and rotations, 1 for angles.
+/// Rows of a variable in its space's Jacobian: its [dimension](Variable::dimension).
 pub(crate) fn width(variable: Variable) -> usize {
-    match variable {
-        Variable::Swivel | Variable::Elbow => 1,
-        Variable::Pw | Variable::Ow | Variable::Os => 3,
-    }
+    variable.dimension()
 }

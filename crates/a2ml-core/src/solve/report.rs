@@ -2,7 +2,7 @@
 //! the CLI's summary table, the MCAP annotations and the Python `Plan` are made from.
 
 use crate::decompose::{ActionType, SegmentPattern};
-use crate::language::{SolverChoice, Space, Variable};
+use crate::language::{Measure, SolverChoice, Space, Variable};
 use crate::math::{Real, UnitQuaternion, Vector3};
 use crate::solve::map::MapSummary;
 use crate::spelling::spelled;
@@ -18,16 +18,22 @@ pub struct Tolerance {
 }
 
 impl Tolerance {
-    /// The tolerance of `variable`: [`Self::position`] for Pw (m), [`Self::angle`] for the
-    /// rotations and angles (rad).
+    /// The tolerance of `variable`, by what its errors [measure](Variable::measure):
+    /// [`Self::position`] for a length (m), [`Self::angle`] for an angle (rad).
     pub fn of(&self, variable: Variable) -> Real {
-        if variable == Variable::Pw { self.position } else { self.angle }
+        match variable.measure() {
+            Measure::Length => self.position,
+            Measure::Angle => self.angle,
+        }
     }
 }
 
 impl Default for Tolerance {
     fn default() -> Self {
-        Self { position: 1e-3, angle: 1.0_f64.to_radians() }
+        Self {
+            position: Measure::Length.default_tolerance(),
+            angle: Measure::Angle.default_tolerance(),
+        }
     }
 }
 

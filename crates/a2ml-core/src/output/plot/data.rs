@@ -3,7 +3,7 @@
 //! reads only this.
 
 use crate::decompose::ArmState;
-use crate::language::{Obstacle, SolverChoice, Target, Task, Variable};
+use crate::language::{Obstacle, SolverChoice, Target, Task, ValueKind, Variable};
 use crate::math::{DOF, JointVector, Real, Rotation3, Vector3};
 use crate::output::{RecordedPlan, RecordedSegment};
 use crate::robot::Robot;
@@ -271,28 +271,26 @@ fn featured_panels(
             if featuring.is_empty() {
                 return None;
             }
-            let mut panel = match variable {
-                Variable::Pw => wrist_panel(plan, times, states),
-                Variable::Swivel | Variable::Elbow => angle_panel(variable, plan, times, states),
-                Variable::Ow | Variable::Os => {
-                    rotation_panel(variable, &featuring, plan, times, states)
-                }
+            let mut panel = match variable.kind() {
+                ValueKind::Position => wrist_panel(plan, times, states),
+                ValueKind::Angle => angle_panel(variable, plan, times, states),
+                ValueKind::Rotation => rotation_panel(variable, &featuring, plan, times, states),
             };
             panel.spans = featuring.iter().map(|(_, s)| (s.start, s.end)).collect();
             for (_, s) in &featuring {
                 let end = &s.reference_end;
-                match variable {
-                    Variable::Pw => {
+                match variable.kind() {
+                    ValueKind::Position => {
                         for (k, value) in end.pw.iter().flat_map(|p| [p.x, p.y, p.z]).enumerate() {
                             panel.targets.push((s.start, s.end, value, k));
                         }
                     }
-                    Variable::Swivel | Variable::Elbow => {
+                    ValueKind::Angle => {
                         if let Some(a) = reference_angle(end, variable) {
                             panel.targets.push((s.start, s.end, a.to_degrees(), 0));
                         }
                     }
-                    Variable::Ow | Variable::Os => {
+                    ValueKind::Rotation => {
                         if reference_rotation(end, variable).is_some() {
                             panel.targets.push((s.start, s.end, 0.0, 0));
                         }

@@ -85,6 +85,26 @@ fn finite_scalar(x: Real, what: &'static str) -> Result<(), ProfileError> {
     if x.is_finite() { Ok(()) } else { Err(ProfileError::NonFinite { what }) }
 }
 
+/// A motion along `direction` (a line's direction or a turn's axis) by the signed `size`, as
+/// the unit direction the motion goes (turned round for a negative size) and the bell over
+/// |size|, so that the travelled distance is never negative: the `line` and `about` of a
+/// position and the `about` of a rotation. `size_name` and `direction_name` name the
+/// values in an error.
+///
+/// # Errors
+/// A non-finite size, a non-finite or zero direction, or an invalid duration.
+fn signed_motion(
+    direction: &Vector3,
+    size: Real,
+    duration: Real,
+    (size_name, direction_name): (&'static str, &'static str),
+) -> Result<(Vector3, BellProfile), ProfileError> {
+    finite_scalar(size, size_name)?;
+    let direction = unit(direction, direction_name)?;
+    let direction = if size < 0.0 { -direction } else { direction };
+    Ok((direction, BellProfile::new(duration, size.abs())?))
+}
+
 /// The reference of one state variable over a primitive, typed by the variable's kind.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Reference {

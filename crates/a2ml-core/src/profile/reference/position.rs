@@ -1,7 +1,7 @@
 //! The reference of Pw: a line, a turn about an axis through S, a semi-elliptic arc, or a
 //! hold.
 
-use super::{finite_scalar, finite_vector, unit};
+use super::{finite_vector, signed_motion};
 use crate::math::{PI, Real, Vector3, reject, rotation_about};
 use crate::profile::{BellProfile, ProfileError, SemiEllipse};
 
@@ -57,10 +57,8 @@ impl PositionReference {
         duration: Real,
     ) -> Result<Self, ProfileError> {
         finite_vector(&start, "start position")?;
-        finite_scalar(length, "line length")?;
-        let direction = unit(direction, "line direction")?;
-        let direction = if length < 0.0 { -direction } else { direction };
-        let bell = BellProfile::new(duration, length.abs())?;
+        let (direction, bell) =
+            signed_motion(direction, length, duration, ("line length", "line direction"))?;
         Ok(Self { start, path: PositionPath::Line { direction }, bell })
     }
 
@@ -93,10 +91,7 @@ impl PositionReference {
         duration: Real,
     ) -> Result<Self, ProfileError> {
         finite_vector(&start, "start position")?;
-        finite_scalar(angle, "angle")?;
-        let axis = unit(axis, "axis")?;
-        let axis = if angle < 0.0 { -axis } else { axis };
-        let bell = BellProfile::new(duration, angle.abs())?;
+        let (axis, bell) = signed_motion(axis, angle, duration, ("angle", "axis"))?;
         Ok(Self { start, path: PositionPath::About { axis }, bell })
     }
 

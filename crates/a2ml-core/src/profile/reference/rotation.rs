@@ -1,6 +1,6 @@
 //! The reference of a rotation, Ow or Os: a geodesic, a turn about a fixed axis, or a hold.
 
-use super::{finite_rotation, finite_scalar, unit};
+use super::{finite_rotation, signed_motion};
 use crate::math::{Real, Rotation3, Vector3, rotation_about, rotation_log, skew};
 use crate::profile::{BellProfile, ProfileError};
 
@@ -73,10 +73,7 @@ impl RotationReference {
         duration: Real,
     ) -> Result<Self, ProfileError> {
         finite_rotation(&start, "start rotation")?;
-        finite_scalar(angle, "angle")?;
-        let axis = unit(axis, "axis")?;
-        let axis = if angle < 0.0 { -axis } else { axis };
-        let bell = BellProfile::new(duration, angle.abs())?;
+        let (axis, bell) = signed_motion(axis, angle, duration, ("angle", "axis"))?;
         Ok(Self { start, path: RotationPath::About { axis }, bell })
     }
 
