@@ -1,7 +1,9 @@
-//! Joint-space RRT-Connect on the MotionBenchMaker Panda scenes of tests/data/mbm (rotated
-//! boxes and cylinders), in both arm models: `robots/panda.urdf` (capsules, the hand and
-//! fingers) and VAMP's 59 spheres (tests/data/panda_spheres). Per scene and model, the solve
-//! rate and median over its problems, then one criterion measurement over a fixed set of them.
+//! Joint-space RRT-Connect on the seven MotionBenchMaker Panda scenes of tests/data/mbm
+//! (rotated boxes and cylinders), in both arm models: `robots/panda.urdf` (capsules, the hand
+//! and fingers) and VAMP's 59 spheres (tests/data/panda_spheres). Per scene and model, the
+//! solve rate and median over its 100 problems with what a solved problem costs (samples, tree
+//! nodes, collision queries, time per query), then one criterion measurement over a fixed set
+//! of them. `cargo bench --bench mbm -- none` prints the table alone.
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -9,7 +11,7 @@ use std::time::Instant;
 use a2ml::Robot;
 use a2ml::collision::CollisionScene;
 use a2ml::math::Real;
-use a2ml::solve::rrt::{RrtOptions, rrt_connect};
+use a2ml::solve::rrt::{RrtOptions, RrtStats, rrt_connect};
 use criterion::{Criterion, criterion_group, criterion_main};
 
 #[path = "../tests/it/mbm_problems.rs"]
@@ -18,6 +20,28 @@ mod mbm_problems;
 /// The arm models compared: name and URDF path in the repository.
 const MODELS: [(&str, &str); 2] =
     [("capsules", "robots/panda.urdf"), ("spheres", "tests/data/panda_spheres/panda_spheres.urdf")];
+
+/// The median of `values` (NaN for none).
+fn median(mut values: Vec<Real>) -> Real {
+    values.sort_by(Real::total_cmp);
+    values.get(values.len() / 2).copied().unwrap_or(Real::NAN)
+}
+
+/// One line of the table: solve rate, median time, and the median counters of a solved problem.
+fn report(model: &str, name: &str, total: usize, solved: &[(Real, RrtStats)]) {
+    let of = |f: fn(&(Real, RrtStats)) -> Real| median(solved.iter().map(f).collect());
+    let per_check = of(|(t, s)| t / s.collision_checks.max(1) as Real);
+    println!(
+        "mbm/{model}/{name}: {} of {total} solved, median {:.3} ms; per solved problem (medians) \
+         {} samples, {} nodes, {} collision queries, {:.2} µs per query",
+        solved.len(),
+        of(|(t, _)| *t) * 1e3,
+        of(|(_, s)| s.samples as Real),
+        of(|(_, s)| s.nodes as Real),
+        of(|(_, s)| s.collision_checks as Real),
+        per_check * 1e6,
+    );
+}
 
 fn mbm(c: &mut Criterion) {
     let options = RrtOptions::default();
@@ -30,23 +54,16 @@ fn mbm(c: &mut Criterion) {
                 .into_iter()
                 .map(|p| (CollisionScene::new(&p.obstacles), p))
                 .collect();
-            let mut times = Vec::new();
+            let mut solved = Vec::new();
             let mut solvable = Vec::new();
             for (scene, p) in &problems {
                 let started = Instant::now();
-                if rrt_connect(&robot, scene, &p.start, &p.goals, &options).is_ok() {
-                    times.push(started.elapsed().as_secs_f64());
+                if let Ok(path) = rrt_connect(&robot, scene, &p.start, &p.goals, &options) {
+                    solved.push((started.elapsed().as_secs_f64(), path.stats));
                     solvable.push((scene, p));
                 }
             }
-            times.sort_by(Real::total_cmp);
-            let median = times.get(times.len() / 2).copied().unwrap_or(Real::NAN);
-            println!(
-                "mbm/{model}/{name}: {} of {} solved, median {:.3} ms",
-                times.len(),
-                problems.len(),
-                median * 1e3
-            );
+            report(model, name, problems.len(), &solved);
             solvable.truncate(10);
             group.bench_function(format!("{model}/{name}_10_problems"), |b| {
                 b.iter(|| {
