@@ -269,7 +269,9 @@ const REDUCTION_LIMIT: Real = 1.0e5;
 /// bits landing in the low bits of the sum.
 const ROUNDER: Real = 6_755_399_441_055_744.0;
 /// π/2 in two parts (fdlibm's pio2_1, pio2_1t): the first has 33 bits, so j · it is exact.
+#[allow(clippy::excessive_precision)] // fdlibm's digits as published: the same doubles.
 const FRAC_PI_2_HIGH: Real = 1.570_796_326_734_125_614_17;
+#[allow(clippy::excessive_precision)] // fdlibm's digits as published: the same doubles.
 const FRAC_PI_2_LOW: Real = 6.077_100_506_506_192_249_32e-11;
 
 /// Sine and cosine of each lane.
@@ -304,6 +306,7 @@ fn reduced_sin_cos(x: &Lane) -> (Lane, Lane) {
 }
 
 /// sin y for |y| ≤ π/4 (fdlibm's __kernel_sin, no tail).
+#[allow(clippy::excessive_precision)] // fdlibm's digits as published: the same doubles.
 #[inline(always)]
 fn kernel_sin(y: Real) -> Real {
     const S1: Real = -1.666_666_666_666_663_243_48e-1;
@@ -319,6 +322,7 @@ fn kernel_sin(y: Real) -> Real {
 }
 
 /// cos y for |y| ≤ π/4 (fdlibm's __kernel_cos, no tail).
+#[allow(clippy::excessive_precision)] // fdlibm's digits as published: the same doubles.
 #[inline(always)]
 fn kernel_cos(y: Real) -> Real {
     const C1: Real = 4.166_666_666_666_660_190_37e-2;
