@@ -1,15 +1,16 @@
 //! Hot paths of the kinematics: FK + J_ge, CPSA state + J_cs, analytic IK
-//! (all branches, and the nearest only), closed-form swivel intervals.
+//! (all branches, and the nearest only), closed-form swivel intervals; and per configuration
+//! of a batch, the batched kernel (`BatchedChain`) against `arm_pose` in a loop.
 
 use std::hint::black_box;
 
 use a2ml::Robot;
 use a2ml::kinematics::{
-    arm_pose, cpsa_jacobian, cpsa_state, geometric_jacobian, hat_jacobian, hat_state, ik_cpsa,
-    ik_cpsa_nearest, swivel_intervals,
+    BatchedChain, FRAME_VALUES, JACOBIAN_VALUES, arm_pose, cpsa_jacobian, cpsa_state,
+    geometric_jacobian, hat_jacobian, hat_state, ik_cpsa, ik_cpsa_nearest, swivel_intervals,
 };
 use a2ml::math::JointVector;
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 
 fn robot(name: &str) -> Robot {
     Robot::from_urdf_file(format!("{}/robots/{name}.urdf", env!("CARGO_MANIFEST_DIR")))
@@ -63,5 +64,53 @@ fn kinematics(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, kinematics);
+/// Configurations per batch.
+const BATCH: usize = 1000;
+
+/// `BATCH` rows of joint values spread over the limits (row-major), as a batch caller has them.
+fn batch(robot: &Robot) -> Vec<f64> {
+    let (lo, hi) = (robot.lower(), robot.upper());
+    (0..BATCH * 7)
+        .map(|i| {
+            let (row, k) = (i / 7, i % 7);
+            let fraction = ((row * 7 + k * 3) % 101) as f64 / 100.0;
+            lo[k] + fraction * (hi[k] - lo[k])
+        })
+        .collect()
+}
+
+fn batched(c: &mut Criterion) {
+    for name in ["iiwa14", "panda"] {
+        let robot = robot(name);
+        let chain = BatchedChain::new(&robot);
+        let q = batch(&robot);
+        let mut frames = vec![0.0; BATCH * FRAME_VALUES];
+        let mut jacobians = vec![0.0; BATCH * JACOBIAN_VALUES];
+        let mut group = c.benchmark_group(format!("{name}_batch"));
+        group.throughput(Throughput::Elements(BATCH as u64));
+        group.bench_function("hand_frames", |b| {
+            b.iter(|| chain.hand_frames(black_box(&q), &mut frames))
+        });
+        group.bench_function("jacobians", |b| {
+            b.iter(|| chain.jacobians(black_box(&q), &mut jacobians))
+        });
+        group.bench_function("hand_frames_and_jacobians", |b| {
+            b.iter(|| chain.hand_frames_and_jacobians(black_box(&q), &mut frames, &mut jacobians))
+        });
+        group.bench_function("cpsa_states", |b| {
+            b.iter(|| chain.cpsa_states(&robot, black_box(&q), |_, s| drop(black_box(s))))
+        });
+        group.bench_function("arm_pose_loop_hand+J_ge", |b| {
+            b.iter(|| {
+                for row in black_box(&q).chunks_exact(7) {
+                    let pose = arm_pose(&robot, &JointVector::from_column_slice(row));
+                    black_box((pose.hand_frame(), geometric_jacobian(&pose)));
+                }
+            })
+        });
+        group.finish();
+    }
+}
+
+criterion_group!(benches, kinematics, batched);
 criterion_main!(benches);

@@ -4,8 +4,9 @@
 //! A call from Python costs more in conversions than the core spends on FK, so these read
 //! float64 arrays in place (any other array-like is converted once), write into arrays the
 //! caller passes (`out=`) or into one array made for the result, and run the rows with the
-//! GIL released. Rows are computed in order on the calling thread: a caller who wants more
-//! threads splits the batch, which the released GIL lets run in parallel.
+//! GIL released, by the core's batched kernel (`kinematics::BatchedChain`: several rows side by
+//! side). Rows are computed on the calling thread: a caller who wants more threads splits the
+//! batch, which the released GIL lets run in parallel, with the same bits per row.
 
 use a2ml_core::kinematics::{self, ArmPose, CpsaState, KinematicsError};
 use a2ml_core::math::{DOF, Jacobian6x7, JointVector, Matrix3, Real, Vector3};
@@ -21,8 +22,8 @@ use crate::errors::CoreError;
 use crate::robot::PyRobot;
 
 /// Values per row of each batched array.
-const FRAME: usize = 16;
-const JACOBIAN: usize = 6 * DOF;
+const FRAME: usize = kinematics::FRAME_VALUES;
+const JACOBIAN: usize = kinematics::JACOBIAN_VALUES;
 
 /// A float64 n-dimensional numpy array.
 pub(crate) type Array<'py> = Bound<'py, PyArrayDyn<Real>>;
@@ -247,12 +248,8 @@ impl PyRobot {
         let result = output(py, out, "out", &[rows.count, 4, 4])?;
         let mut guard = writer(&result, "out")?;
         let (values, out) = (rows.values(), slots(&mut guard));
-        py.detach(|| {
-            for (q, frame) in values.chunks_exact(DOF).zip(out.chunks_exact_mut(FRAME)) {
-                let pose = kinematics::arm_pose(&self.robot, &JointVector::from_column_slice(q));
-                write_frame(frame, &pose);
-            }
-        });
+        let chain = kinematics::BatchedChain::new(&self.robot);
+        py.detach(|| chain.hand_frames(values, out));
         drop(guard);
         Ok(result)
     }
@@ -269,12 +266,8 @@ impl PyRobot {
         let result = output(py, out, "out", &[rows.count, 6, DOF])?;
         let mut guard = writer(&result, "out")?;
         let (values, out) = (rows.values(), slots(&mut guard));
-        py.detach(|| {
-            for (q, j) in values.chunks_exact(DOF).zip(out.chunks_exact_mut(JACOBIAN)) {
-                let pose = kinematics::arm_pose(&self.robot, &JointVector::from_column_slice(q));
-                write_jacobian(j, &kinematics::geometric_jacobian(&pose));
-            }
-        });
+        let chain = kinematics::BatchedChain::new(&self.robot);
+        py.detach(|| chain.jacobians(values, out));
         drop(guard);
         Ok(result)
     }
@@ -297,23 +290,26 @@ impl PyRobot {
         let values = rows.values();
         let (pw_out, ow_out, swivel_out) =
             (slots(&mut pw_guard), slots(&mut ow_guard), slots(&mut swivel_guard));
+        let chain = kinematics::BatchedChain::new(&self.robot);
         let failed = py.detach(|| {
-            for (i, q) in values.chunks_exact(DOF).enumerate() {
-                let pose = kinematics::arm_pose(&self.robot, &JointVector::from_column_slice(q));
-                let s = match kinematics::cpsa_state(&self.robot, &pose) {
-                    Ok(s) => s,
-                    Err(e) => return Some((i, e)),
-                };
-                pw_out[3 * i..3 * i + 3].copy_from_slice(s.pw.as_slice());
-                let r = s.ow.matrix();
-                for a in 0..3 {
-                    for b in 0..3 {
-                        ow_out[9 * i + 3 * a + b] = r[(a, b)];
+            let mut failed = None;
+            chain.cpsa_states(&self.robot, values, |i, state| match state {
+                Ok(s) if failed.is_none() => {
+                    pw_out[3 * i..3 * i + 3].copy_from_slice(s.pw.as_slice());
+                    let r = s.ow.matrix();
+                    for a in 0..3 {
+                        for b in 0..3 {
+                            ow_out[9 * i + 3 * a + b] = r[(a, b)];
+                        }
                     }
+                    swivel_out[i] = s.swivel;
                 }
-                swivel_out[i] = s.swivel;
-            }
-            None
+                Ok(_) => {}
+                Err(e) => {
+                    failed.get_or_insert((i, e));
+                }
+            });
+            failed
         });
         if let Some((row, e)) = failed {
             return Err(row_error(py, row, e));

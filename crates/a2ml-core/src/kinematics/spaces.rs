@@ -71,8 +71,16 @@ struct Triangle {
 
 impl Triangle {
     fn new(pose: &ArmPose) -> Result<Self, KinematicsError> {
-        let se = pose.elbow - pose.shoulder;
-        let ew = pose.wrist - pose.elbow;
+        Self::from_points(&pose.shoulder, &pose.elbow, &pose.wrist)
+    }
+
+    fn from_points(
+        shoulder: &Vector3,
+        elbow: &Vector3,
+        wrist: &Vector3,
+    ) -> Result<Self, KinematicsError> {
+        let se = elbow - shoulder;
+        let ew = wrist - elbow;
         let (upper, fore) = (se.norm(), ew.norm());
         let (r, u) = (se / upper, ew / fore);
         let v = u.cross(&r);
@@ -117,9 +125,18 @@ impl TriangleRates {
 /// # Errors
 /// [`Singularity::StraightArm`], [`Singularity::WristAboveShoulder`].
 pub fn cpsa_state(robot: &Robot, pose: &ArmPose) -> Result<CpsaState, KinematicsError> {
-    let t = Triangle::new(pose)?;
-    let pw = pose.wrist - pose.shoulder;
-    Ok(CpsaState { pw, ow: pose.hand, swivel: swivel_angle(&pw, &t.l, &robot.vertical)? })
+    cpsa_from_points(robot, &pose.elbow, &pose.wrist, pose.hand)
+}
+
+/// The CPSA state of an arm with E and W (in {b}, S at the origin) and hand rotation Ow.
+pub(crate) fn cpsa_from_points(
+    robot: &Robot,
+    elbow: &Vector3,
+    wrist: &Vector3,
+    ow: Rotation3,
+) -> Result<CpsaState, KinematicsError> {
+    let t = Triangle::from_points(&Vector3::zeros(), elbow, wrist)?;
+    Ok(CpsaState { pw: *wrist, ow, swivel: swivel_angle(wrist, &t.l, &robot.vertical)? })
 }
 
 /// The HAT state at a pose.

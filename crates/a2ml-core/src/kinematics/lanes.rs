@@ -1,0 +1,521 @@
+//! Forward kinematics of many configurations at once: [`BatchedChain`] runs [`LANES`]
+//! configurations side by side, each matrix entry a `[Real; LANES]`, so every step is a loop
+//! over lanes that the compiler vectorises (no intrinsics, no `unsafe`).
+//!
+//! The chain is taken in aligned frames (each joint's axis turned onto z, as
+//! [`super::AlignedChain`] does), so a joint costs one constant rotation product and a
+//! two-column turn. Sines and cosines are computed per lane by the polynomials of fdlibm's
+//! kernels (within an ulp or two of the platform's), the angle reduced by a two-part π/2.
+//! Lanes never mix: a configuration's result does not depend on the others in its group, so
+//! any split of a batch gives the same bits.
+
+use super::error::KinematicsError;
+use super::spaces::{CpsaState, cpsa_from_points};
+use crate::math::{DOF, Matrix3, Real, Rotation3, Vector3};
+
+const FRAC_2_PI: Real = std::f64::consts::FRAC_2_PI;
+use crate::robot::Robot;
+
+/// Configurations computed side by side.
+pub const LANES: usize = 4;
+
+/// Values per row of the batched results: a 4x4 frame, a 6x7 Jacobian.
+pub const FRAME_VALUES: usize = 16;
+/// Values per row of a batched J_ge.
+pub const JACOBIAN_VALUES: usize = 6 * DOF;
+
+/// One value per lane.
+type Lane = [Real; LANES];
+/// A 3-vector per lane.
+type LaneVector = [Lane; 3];
+/// A 3x3 matrix per lane, `m[row][column]`.
+type LaneMatrix = [[Lane; 3]; 3];
+
+/// One joint of the aligned chain: the constant transform from the parent's aligned frame to
+/// this joint's, before the turn about z.
+#[derive(Debug, Clone, Copy)]
+struct Step {
+    rotation: [[Real; 3]; 3],
+    translation: [Real; 3],
+}
+
+/// The robot's chain prepared for [`LANES`] configurations at a time.
+///
+/// Batched results pair rows as `Iterator::zip` does: `q` holds rows of 7 joint values
+/// (row-major), each output its rows; the shorter of the two sets the count.
+#[derive(Debug, Clone)]
+pub struct BatchedChain {
+    steps: [Step; DOF],
+    /// E in aligned frame 3.
+    elbow: [Real; 3],
+    /// W in aligned frame 6.
+    wrist: [Real; 3],
+    /// Ow from aligned frame 7: the hand's rotation in that frame.
+    hand: [[Real; 3]; 3],
+}
+
+/// What forward kinematics gives for one group of lanes, in {b}.
+struct GroupPose {
+    /// The joint axes.
+    axes: [LaneVector; DOF],
+    /// A point of each joint axis.
+    axis_points: [LaneVector; DOF],
+    elbow: LaneVector,
+    wrist: LaneVector,
+    /// Ow.
+    hand: LaneMatrix,
+}
+
+/// A rotation whose z column is `axis`, its x and y from a cross product with the basis
+/// vector farthest from the axis: orthonormal to an ulp whatever the axis (nalgebra's
+/// `rotation_between` takes the angle by acos, which loses half the digits of an axis a few
+/// microradians off z, as URDFs exported with rounding have).
+fn aligning(axis: &Vector3) -> Matrix3 {
+    let z = axis.normalize();
+    let helper = if z.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+    let y = z.cross(&helper).normalize();
+    Matrix3::from_columns(&[y.cross(&z), y, z])
+}
+
+fn rows_of(m: &Matrix3) -> [[Real; 3]; 3] {
+    std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)]))
+}
+
+fn values_of(v: &Vector3) -> [Real; 3] {
+    [v.x, v.y, v.z]
+}
+
+impl BatchedChain {
+    /// The chain of `robot`.
+    pub fn new(robot: &Robot) -> Self {
+        let align: [Matrix3; DOF] = std::array::from_fn(|k| aligning(&robot.joints[k].axis));
+        // A_{k-1}ᵀ for frame k, the identity for {b}.
+        let aligned_from_frame =
+            |k: usize| if k == 0 { Matrix3::identity() } else { align[k - 1].transpose() };
+        let steps = std::array::from_fn(|k| {
+            let p = &robot.joints[k].parent_from_joint;
+            let before = aligned_from_frame(k);
+            Step {
+                rotation: rows_of(&(before * p.rotation.matrix() * align[k])),
+                translation: values_of(&(before * p.translation.vector)),
+            }
+        });
+        let s = &robot.structure;
+        Self {
+            steps,
+            elbow: values_of(&(aligned_from_frame(3) * s.elbow_in_frame3)),
+            wrist: values_of(&(aligned_from_frame(6) * s.wrist_in_frame6)),
+            hand: rows_of(&(aligned_from_frame(DOF) * robot.frame7_from_hand.matrix())),
+        }
+    }
+
+    /// The hand frame {W} (row-major 4x4: Ow and W) at each row of `q`.
+    pub fn hand_frames(&self, q: &[Real], frames: &mut [Real]) {
+        let rows = frames.chunks_exact_mut(FRAME_VALUES);
+        self.each_group(q, rows, |pose, lane, frame| write_frame(frame, pose, lane));
+    }
+
+    /// J_ge (row-major 6x7, as [`super::geometric_jacobian`]) at each row of `q`.
+    pub fn jacobians(&self, q: &[Real], jacobians: &mut [Real]) {
+        let rows = jacobians.chunks_exact_mut(JACOBIAN_VALUES);
+        self.each_group(q, rows, |pose, lane, j| write_jacobian(j, pose, lane));
+    }
+
+    /// The hand frame and J_ge at each row of `q`, from one forward kinematics.
+    pub fn hand_frames_and_jacobians(
+        &self,
+        q: &[Real],
+        frames: &mut [Real],
+        jacobians: &mut [Real],
+    ) {
+        let rows =
+            frames.chunks_exact_mut(FRAME_VALUES).zip(jacobians.chunks_exact_mut(JACOBIAN_VALUES));
+        self.each_group(q, rows, |pose, lane, (frame, j)| {
+            write_frame(frame, pose, lane);
+            write_jacobian(j, pose, lane);
+        });
+    }
+
+    /// The CPSA state at each row of `q`, as [`super::cpsa_state`] gives it; `states` is
+    /// called with each row's index and result, in order.
+    pub fn cpsa_states(
+        &self,
+        robot: &Robot,
+        q: &[Real],
+        mut states: impl FnMut(usize, Result<CpsaState, KinematicsError>),
+    ) {
+        let rows = q.len() / DOF;
+        self.each_group(q, 0..rows, |pose, lane, row| {
+            let point = |v: &LaneVector| Vector3::new(v[0][lane], v[1][lane], v[2][lane]);
+            let hand = Matrix3::from_fn(|i, j| pose.hand[i][j][lane]);
+            let hand = Rotation3::from_matrix_unchecked(hand);
+            states(row, cpsa_from_points(robot, &point(&pose.elbow), &point(&pose.wrist), hand));
+        });
+    }
+
+    /// Runs `each(pose, lane, out)` for every row of `q` paired with an item of `outputs`,
+    /// [`LANES`] rows at a time; a last short group repeats its last row in the spare lanes.
+    fn each_group<O>(
+        &self,
+        q: &[Real],
+        outputs: impl IntoIterator<Item = O>,
+        mut each: impl FnMut(&GroupPose, usize, O),
+    ) {
+        let mut outputs = outputs.into_iter();
+        for group in q.chunks(DOF * LANES) {
+            let rows = group.len() / DOF;
+            if rows == 0 {
+                return;
+            }
+            let joints: [Lane; DOF] =
+                std::array::from_fn(|k| std::array::from_fn(|l| group[DOF * l.min(rows - 1) + k]));
+            let pose = self.group_pose(&joints);
+            for lane in 0..rows {
+                let Some(out) = outputs.next() else { return };
+                each(&pose, lane, out);
+            }
+        }
+    }
+
+    /// Forward kinematics of one group: `joints[k]` holds joint k's value in each lane.
+    fn group_pose(&self, joints: &[Lane; DOF]) -> GroupPose {
+        let mut rotation: LaneMatrix = std::array::from_fn(|i| {
+            std::array::from_fn(|j| [if i == j { 1.0 } else { 0.0 }; LANES])
+        });
+        let mut translation: LaneVector = [[0.0; LANES]; 3];
+        let mut axes = [[[0.0; LANES]; 3]; DOF];
+        let mut axis_points = [[[0.0; LANES]; 3]; DOF];
+        let (mut elbow, mut wrist) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3]);
+        for (k, step) in self.steps.iter().enumerate() {
+            translation = apply(&rotation, &step.translation, &translation);
+            let m = times_constant(&rotation, &step.rotation);
+            let (sin, cos) = sin_cos(&joints[k]);
+            rotation = std::array::from_fn(|i| {
+                let (x, y) = (&m[i][0], &m[i][1]);
+                [
+                    std::array::from_fn(|l| x[l] * cos[l] + y[l] * sin[l]),
+                    std::array::from_fn(|l| y[l] * cos[l] - x[l] * sin[l]),
+                    m[i][2],
+                ]
+            });
+            axes[k] = [m[0][2], m[1][2], m[2][2]];
+            axis_points[k] = translation;
+            // E rides on frame 3, W on frame 6.
+            if k == 2 {
+                elbow = apply(&rotation, &self.elbow, &translation);
+            } else if k == 5 {
+                wrist = apply(&rotation, &self.wrist, &translation);
+            }
+        }
+        GroupPose { axes, axis_points, elbow, wrist, hand: times_constant(&rotation, &self.hand) }
+    }
+}
+
+/// `m c` with c the same in every lane.
+#[inline(always)]
+fn times_constant(m: &LaneMatrix, c: &[[Real; 3]; 3]) -> LaneMatrix {
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            std::array::from_fn(|l| {
+                m[i][0][l] * c[0][j] + m[i][1][l] * c[1][j] + m[i][2][l] * c[2][j]
+            })
+        })
+    })
+}
+
+/// `m v + t` with v the same in every lane.
+#[inline(always)]
+fn apply(m: &LaneMatrix, v: &[Real; 3], t: &LaneVector) -> LaneVector {
+    std::array::from_fn(|i| {
+        std::array::from_fn(|l| {
+            t[i][l] + (m[i][0][l] * v[0] + m[i][1][l] * v[1] + m[i][2][l] * v[2])
+        })
+    })
+}
+
+/// Lane `lane`'s hand frame {W} as a row-major 4x4 homogeneous matrix.
+fn write_frame(out: &mut [Real], pose: &GroupPose, lane: usize) {
+    for i in 0..3 {
+        for j in 0..3 {
+            out[4 * i + j] = pose.hand[i][j][lane];
+        }
+        out[4 * i + 3] = pose.wrist[i][lane];
+    }
+    out[12..16].copy_from_slice(&[0.0, 0.0, 0.0, 1.0]);
+}
+
+/// Lane `lane`'s J_ge, row-major: W's velocity (rows 0-2), the hand's angular velocity (3-5).
+fn write_jacobian(out: &mut [Real], pose: &GroupPose, lane: usize) {
+    for k in 0..DOF {
+        let z = pose.axes[k].map(|v| v[lane]);
+        // W rides on frame 6: joint 7 cannot move it.
+        let linear = if k < 6 {
+            let p = pose.axis_points[k].map(|v| v[lane]);
+            let d = [0, 1, 2].map(|i| pose.wrist[i][lane] - p[i]);
+            [z[1] * d[2] - z[2] * d[1], z[2] * d[0] - z[0] * d[2], z[0] * d[1] - z[1] * d[0]]
+        } else {
+            [0.0; 3]
+        };
+        for i in 0..3 {
+            out[DOF * i + k] = linear[i];
+            out[DOF * (i + 3) + k] = z[i];
+        }
+    }
+}
+
+/// Past this |angle| (rad) the two-part reduction loses bits: the platform's sin_cos then.
+const REDUCTION_LIMIT: Real = 1.0e5;
+/// 1.5 · 2^52: adding and subtracting it rounds to the nearest integer, the integer's low
+/// bits landing in the low bits of the sum.
+const ROUNDER: Real = 6_755_399_441_055_744.0;
+/// π/2 in two parts (fdlibm's pio2_1, pio2_1t): the first has 33 bits, so j · it is exact.
+#[allow(clippy::excessive_precision)] // fdlibm's digits as published: the same doubles.
+const FRAC_PI_2_HIGH: Real = 1.570_796_326_734_125_614_17;
+#[allow(clippy::excessive_precision)] // fdlibm's digits as published: the same doubles.
+const FRAC_PI_2_LOW: Real = 6.077_100_506_506_192_249_32e-11;
+
+/// Sine and cosine of each lane.
+#[inline(always)]
+fn sin_cos(x: &Lane) -> (Lane, Lane) {
+    if x.iter().all(|v| v.abs() <= REDUCTION_LIMIT) {
+        reduced_sin_cos(x)
+    } else {
+        let pairs = x.map(Real::sin_cos);
+        (pairs.map(|p| p.0), pairs.map(|p| p.1))
+    }
+}
+
+/// Sine and cosine for |x| ≤ [`REDUCTION_LIMIT`]: x = jπ/2 + y with |y| ≤ π/4, fdlibm's
+/// kernels at y, then the quadrant j mod 4 swaps and signs them.
+#[inline(always)]
+fn reduced_sin_cos(x: &Lane) -> (Lane, Lane) {
+    let shifted: Lane = std::array::from_fn(|l| x[l] * FRAC_2_PI + ROUNDER);
+    let mut sin = [0.0; LANES];
+    let mut cos = [0.0; LANES];
+    for l in 0..LANES {
+        let j = shifted[l] - ROUNDER;
+        let y = (x[l] - j * FRAC_PI_2_HIGH) - j * FRAC_PI_2_LOW;
+        let (s, c) = (kernel_sin(y), kernel_cos(y));
+        let quadrant = shifted[l].to_bits() & 3;
+        let (s, c) = if quadrant & 1 == 1 { (c, s) } else { (s, c) };
+        // Quadrants 2, 3 negate the sine; 1, 2 the cosine.
+        sin[l] = Real::from_bits(s.to_bits() ^ ((quadrant & 2) << 62));
+        cos[l] = Real::from_bits(c.to_bits() ^ (((quadrant + 1) & 2) << 62));
+    }
+    (sin, cos)
+}
+
+/// sin y for |y| ≤ π/4 (fdlibm's __kernel_sin, no tail).
+#[allow(clippy::excessive_precision)] // fdlibm's digits as published: the same doubles.
+#[inline(always)]
+fn kernel_sin(y: Real) -> Real {
+    const S1: Real = -1.666_666_666_666_663_243_48e-1;
+    const S2: Real = 8.333_333_333_322_489_461_24e-3;
+    const S3: Real = -1.984_126_982_985_794_931_34e-4;
+    const S4: Real = 2.755_731_370_707_006_767_89e-6;
+    const S5: Real = -2.505_076_025_340_686_341_95e-8;
+    const S6: Real = 1.589_690_995_211_550_102_21e-10;
+    let z = y * y;
+    let w = z * z;
+    let r = S2 + z * (S3 + z * S4) + z * w * (S5 + z * S6);
+    y + z * y * (S1 + z * r)
+}
+
+/// cos y for |y| ≤ π/4 (fdlibm's __kernel_cos, no tail).
+#[allow(clippy::excessive_precision)] // fdlibm's digits as published: the same doubles.
+#[inline(always)]
+fn kernel_cos(y: Real) -> Real {
+    const C1: Real = 4.166_666_666_666_660_190_37e-2;
+    const C2: Real = -1.388_888_888_887_410_957_49e-3;
+    const C3: Real = 2.480_158_728_947_672_941_78e-5;
+    const C4: Real = -2.755_731_435_139_066_330_35e-7;
+    const C5: Real = 2.087_572_321_298_174_827_90e-9;
+    const C6: Real = -1.135_964_755_778_819_482_65e-11;
+    let z = y * y;
+    let w = z * z;
+    let r = z * (C1 + z * (C2 + z * C3)) + w * w * (C4 + z * (C5 + z * C6));
+    let half = 0.5 * z;
+    let one_minus = 1.0 - half;
+    one_minus + (((1.0 - one_minus) - half) + z * r)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kinematics::{arm_pose, cpsa_state, geometric_jacobian};
+    use crate::math::PI;
+
+    const ROBOTS: [&str; 6] =
+        ["iiwa14", "panda", "centauro_right_arm", "coman_right_arm", "human_arm", "swivel_map_arm"];
+
+    fn robot(name: &str) -> Robot {
+        let path = format!("{}/../../robots/{name}.urdf", env!("CARGO_MANIFEST_DIR"));
+        Robot::from_urdf_file(path).expect("shipped robot loads")
+    }
+
+    /// `count` rows of joint values, in the limits and up to a turn past them (a batch is not
+    /// checked against the limits), from a fixed linear congruential sequence.
+    fn configurations(robot: &Robot, count: usize) -> Vec<Real> {
+        let mut state: u64 = 0x2545_f491_4f6c_dd1d;
+        let mut unit = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as Real / (1u64 << 53) as Real
+        };
+        let (lo, hi) = (robot.lower(), robot.upper());
+        (0..count * DOF)
+            .map(|i| {
+                let k = i % DOF;
+                let span = hi[k] - lo[k] + 4.0 * PI;
+                lo[k] - 2.0 * PI + unit() * span
+            })
+            .collect()
+    }
+
+    fn joint_vector(row: &[Real]) -> crate::math::JointVector {
+        crate::math::JointVector::from_column_slice(row)
+    }
+
+    /// The batched kernel multiplies in another order than `arm_pose` and takes its sines from
+    /// other polynomials than the platform's: each differs by a few ulps, which over a chain
+    /// of seven joints on an arm of about a metre stays far below 1e-12.
+    const AGREEMENT: Real = 1e-12;
+
+    fn largest_difference(a: &[Real], b: &[Real]) -> Real {
+        assert_eq!(a.len(), b.len());
+        a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, Real::max)
+    }
+
+    #[test]
+    fn sines_and_cosines_agree_with_the_platform_to_an_ulp_or_two() {
+        let mut worst: Real = 0.0;
+        for i in -200_000..=200_000 {
+            let x = i as Real * 2.5e-4 + 1e-7 * (i % 7) as Real;
+            let (s, c) = reduced_sin_cos(&[x; LANES]);
+            let (es, ec) = x.sin_cos();
+            worst = worst.max((s[0] - es).abs()).max((c[0] - ec).abs());
+        }
+        assert!(worst <= 3.4e-16, "worst difference {worst:e}");
+        // Past the reduction's range the platform's own, exactly.
+        let far = [3.0e5, -1.0e9, 0.5, 1e300];
+        let (s, c) = sin_cos(&far);
+        for l in 0..LANES {
+            assert_eq!((s[l], c[l]), far[l].sin_cos());
+        }
+    }
+
+    #[test]
+    fn sines_keep_their_sign_at_the_quadrant_edges() {
+        for j in -8..=8 {
+            let x = j as Real * std::f64::consts::FRAC_PI_2;
+            let (s, c) = reduced_sin_cos(&[x; LANES]);
+            let (es, ec) = x.sin_cos();
+            assert!((s[0] - es).abs() < 1e-15 && (c[0] - ec).abs() < 1e-15, "at {j} π/2");
+        }
+    }
+
+    #[test]
+    fn batched_frames_and_jacobians_match_the_per_configuration_functions() {
+        for name in ROBOTS {
+            let robot = robot(name);
+            let chain = BatchedChain::new(&robot);
+            let count = 4 * LANES + 3;
+            let q = configurations(&robot, count);
+            let mut frames = vec![Real::NAN; count * FRAME_VALUES];
+            let mut jacobians = vec![Real::NAN; count * JACOBIAN_VALUES];
+            chain.hand_frames_and_jacobians(&q, &mut frames, &mut jacobians);
+            for (i, row) in q.chunks_exact(DOF).enumerate() {
+                let pose = arm_pose(&robot, &joint_vector(row));
+                let h = pose.hand_frame().to_homogeneous();
+                let expected: Vec<Real> = (0..16).map(|v| h[(v / 4, v % 4)]).collect();
+                let got = &frames[i * FRAME_VALUES..(i + 1) * FRAME_VALUES];
+                let d = largest_difference(got, &expected);
+                assert!(d < AGREEMENT, "{name} row {i}: frame differs by {d:e}");
+                let j = geometric_jacobian(&pose);
+                let expected: Vec<Real> =
+                    (0..JACOBIAN_VALUES).map(|v| j[(v / DOF, v % DOF)]).collect();
+                let got = &jacobians[i * JACOBIAN_VALUES..(i + 1) * JACOBIAN_VALUES];
+                let d = largest_difference(got, &expected);
+                assert!(d < AGREEMENT, "{name} row {i}: J_ge differs by {d:e}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_row_gets_the_same_bits_however_the_batch_is_split() {
+        let robot = robot("iiwa14");
+        let chain = BatchedChain::new(&robot);
+        let count = 3 * LANES + 1;
+        let q = configurations(&robot, count);
+        let (mut frames, mut jacobians) =
+            (vec![0.0; count * FRAME_VALUES], vec![0.0; count * JACOBIAN_VALUES]);
+        chain.hand_frames_and_jacobians(&q, &mut frames, &mut jacobians);
+        let (mut alone_frames, mut alone_jacobians) = (frames.clone(), jacobians.clone());
+        alone_frames.fill(0.0);
+        alone_jacobians.fill(0.0);
+        // Row by row, then from an odd offset in pieces of three.
+        for (i, row) in q.chunks_exact(DOF).enumerate() {
+            chain.hand_frames(row, &mut alone_frames[i * FRAME_VALUES..]);
+            chain.jacobians(row, &mut alone_jacobians[i * JACOBIAN_VALUES..]);
+        }
+        assert_eq!(bits(&alone_frames), bits(&frames));
+        assert_eq!(bits(&alone_jacobians), bits(&jacobians));
+        let mut pieces = vec![0.0; count * FRAME_VALUES];
+        chain.hand_frames(&q[..DOF], &mut pieces[..FRAME_VALUES]);
+        for (p, rows) in q[DOF..].chunks(3 * DOF).enumerate() {
+            let start = (1 + 3 * p) * FRAME_VALUES;
+            chain.hand_frames(rows, &mut pieces[start..]);
+        }
+        assert_eq!(bits(&pieces), bits(&frames));
+    }
+
+    fn bits(values: &[Real]) -> Vec<u64> {
+        values.iter().map(|v| v.to_bits()).collect()
+    }
+
+    #[test]
+    fn rows_pair_up_as_zip_does() {
+        let robot = robot("panda");
+        let chain = BatchedChain::new(&robot);
+        let q = configurations(&robot, 6);
+        // Two output rows for six configurations: two written, nothing past them.
+        let mut frames = vec![Real::NAN; 2 * FRAME_VALUES + 5];
+        chain.hand_frames(&q, &mut frames);
+        assert!(frames[..2 * FRAME_VALUES].iter().all(|v| v.is_finite()));
+        assert!(frames[2 * FRAME_VALUES..].iter().all(|v| v.is_nan()));
+        // Six output rows for a configuration and a half: one written.
+        let mut frames = vec![Real::NAN; 6 * FRAME_VALUES];
+        chain.hand_frames(&q[..DOF + 3], &mut frames);
+        assert!(frames[..FRAME_VALUES].iter().all(|v| v.is_finite()));
+        assert!(frames[FRAME_VALUES..].iter().all(|v| v.is_nan()));
+    }
+
+    #[test]
+    fn batched_cpsa_states_match_cpsa_state_errors_included() {
+        for name in ROBOTS {
+            let robot = robot(name);
+            let chain = BatchedChain::new(&robot);
+            let mut q = configurations(&robot, 2 * LANES + 1);
+            // The zero configuration of these arms is straight: a singular row.
+            q[DOF..2 * DOF].fill(0.0);
+            let mut seen = 0;
+            chain.cpsa_states(&robot, &q, |row, state| {
+                assert_eq!(row, seen);
+                seen += 1;
+                let pose = arm_pose(&robot, &joint_vector(&q[row * DOF..(row + 1) * DOF]));
+                match (state, cpsa_state(&robot, &pose)) {
+                    (Ok(got), Ok(expected)) => {
+                        let d = (got.pw - expected.pw).amax();
+                        let r = (got.ow.matrix() - expected.ow.matrix()).amax();
+                        let s = crate::math::wrap_angle(got.swivel - expected.swivel).abs();
+                        assert!(d.max(r).max(s) < 1e-10, "{name} row {row}: {d:e} {r:e} {s:e}");
+                    }
+                    (Err(got), Err(expected)) => assert_eq!(got, expected, "{name} row {row}"),
+                    (got, expected) => panic!("{name} row {row}: {got:?} against {expected:?}"),
+                }
+            });
+            assert_eq!(seen, 2 * LANES + 1);
+        }
+    }
+}
