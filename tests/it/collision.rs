@@ -256,13 +256,17 @@ fn the_collision_model_agrees_with_min_distance() {
                 let (expected, link, obstacle) =
                     min_distance(&robot, &arm_pose(&robot, &q), &scene).expect("pairs");
                 let found = clearance(&model, &q);
-                // parry's distance to a cylinder (o3) is iterative (GJK): rounding in the
-                // forward kinematics moves it by up to a few 1e-9.
-                let tolerance = if obstacle == "o3" { 1e-8 } else { TOL };
-                assert!(
-                    (found - expected).abs() < tolerance,
-                    "{name}: {found} vs {expected} ({link}, {obstacle})"
-                );
+                // parry's distance to a cylinder (o3) is iterative (GJK) and stops up to
+                // ~1e-5 m above the true distance; the model's closed form is within 1e-11 of
+                // a brute-force minimum (the unit test
+                // `segment_distances_to_cylinders_match_brute_force`), so it may be below
+                // parry by that much, never above.
+                let context = format!("{name}: {found} vs {expected} ({link}, {obstacle})");
+                if obstacle == "o3" {
+                    assert!(found < expected + 1e-8 && found > expected - 2e-5, "{context}");
+                } else {
+                    assert!((found - expected).abs() < TOL, "{context}");
+                }
                 if expected < 0.05 {
                     close += 1;
                 }
@@ -302,5 +306,79 @@ fn advancement_keeps_the_clearance_either_way() {
             }
         }
         assert!(moved > 50, "{name}: too few configurations clear to move from: {moved}");
+    }
+}
+
+/// Both Panda models of the MotionBenchMaker comparison: capsules with the hand, and VAMP's
+/// 59 spheres.
+fn mbm_models() -> Vec<(&'static str, a2ml::Robot)> {
+    let path = |p: &str| format!("{}/{p}", env!("CARGO_MANIFEST_DIR"));
+    vec![
+        ("capsules", load("panda")),
+        (
+            "spheres",
+            a2ml::Robot::from_urdf_file(path("tests/data/panda_spheres/panda_spheres.urdf"))
+                .expect("robot loads"),
+        ),
+    ]
+}
+
+/// On the MotionBenchMaker scenes (thin shelves, rotated boxes and cylinders), the collision
+/// model's clearance is parry's pair-by-pair minimum: within 1e-8 m where the arm is clear,
+/// and of the same sign where it is not; and its advancement is safe along the motion and
+/// agrees with the bounded queries the RRT's edge checks make.
+#[test]
+fn the_collision_model_agrees_with_min_distance_on_mbm_scenes() {
+    for (model_name, robot) in mbm_models() {
+        let mut rng = rng(31);
+        let (mut close, mut colliding, mut moved) = (0, 0, 0);
+        for scene_name in crate::mbm_problems::SCENES {
+            let problem = crate::mbm_problems::problems(scene_name).swap_remove(0);
+            let scene = CollisionScene::new(&problem.obstacles);
+            let model = CollisionModel::new(&robot, &scene);
+            let d = |q: &a2ml::math::JointVector| {
+                min_distance(&robot, &arm_pose(&robot, q), &scene).map_or(Real::INFINITY, |m| m.0)
+            };
+            for _ in 0..60 {
+                let q = random_q(&robot, &mut rng);
+                let (expected, found) = (d(&q), clearance(&model, &q));
+                let context = format!("{model_name}/{scene_name}: {found} vs {expected}");
+                if expected > 1e-9 {
+                    assert!((found - expected).abs() < 1e-8, "{context}");
+                    close += usize::from(expected < 0.05);
+                } else if expected < -1e-9 {
+                    assert!(found < 0.0, "{context}");
+                    colliding += 1;
+                }
+                assert_eq!(found.to_bits(), clearance(&model, &q).to_bits(), "{context}");
+                // A motion of an RRT step's length (2 rad).
+                let toward = random_q(&robot, &mut rng) - q;
+                let dq = toward * (2.0 / toward.norm());
+                let kept = 0.01;
+                let s = advancement(&model, &q, &dq, kept);
+                assert_eq!(s < 0.0, expected < kept, "{context}: advancement {s}");
+                for (least, enough) in
+                    [(0.0, 1.0), (0.5 * s, 0.5), (s, Real::INFINITY), (0.01, 0.02)]
+                {
+                    let capped = s.min(enough);
+                    let expected = (capped >= least).then_some(capped);
+                    let within = advancement_within(&model, &q, &dq, kept, least, enough);
+                    assert_eq!(within, expected, "{context}: within {least}..{enough}");
+                }
+                if s <= 0.0 || !s.is_finite() {
+                    continue;
+                }
+                moved += 1;
+                for k in -10..=10 {
+                    let t = s * k as Real / 10.0;
+                    let at = d(&(q + dq * t));
+                    assert!(at >= kept - 1e-9, "{context}: {at} at {t} of {s}");
+                }
+            }
+        }
+        assert!(
+            close > 20 && colliding > 20 && moved > 20,
+            "{model_name}: {close} {colliding} {moved}"
+        );
     }
 }

@@ -1,6 +1,7 @@
 //! [`CollisionModel`]: the arm's capsules and a scene prepared once for queries at many
-//! configurations, without allocating: closed-form capsule–sphere and capsule–capsule
-//! distances, parry only for boxes and cylinders.
+//! configurations, without allocating: closed-form capsule–sphere, capsule–capsule and
+//! capsule–box/cylinder distances (the last settled by tangents of the convex distance along
+//! the segment), parry only for the depth of a segment inside a box or cylinder.
 
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query;
@@ -28,7 +29,7 @@ pub struct CollisionModel {
     groups: Vec<Group>,
     spheres: Vec<Sphere>,
     capsules: Vec<Capsule>,
-    /// Boxes and cylinders: parry for segments, closed forms for points.
+    /// Boxes and cylinders: closed forms, parry for a segment's depth inside.
     convex: Vec<Convex>,
     /// Sorted by the pair of groups, so that [`GroupPair`] ranges cover them.
     self_pairs: Vec<SelfPair>,
@@ -76,6 +77,13 @@ enum Solid {
     Cylinder { radius: Real, half_height: Real },
 }
 
+/// How close [`Convex::segment_distance`] brings its lower and upper bounds before it
+/// answers with the lower (m).
+const SEGMENT_TOLERANCE: Real = 1e-11;
+
+/// Taken off every lower bound from tangents, for their rounding (m).
+const ROUNDING: Real = 1e-12;
+
 impl Convex {
     /// The signed distance from `p` to the solid (negative inside: the depth).
     fn point_distance(&self, p: &Vector3) -> Real {
@@ -91,6 +99,121 @@ impl Convex {
                 radial.max(0.0).hypot(axial.max(0.0)) + radial.max(axial).min(0.0)
             }
         }
+    }
+
+    /// [`Convex::point_distance`] and a subgradient of it at `p` ({b}): the signed distance
+    /// to a convex solid is convex, so `d + g·(x − p)` is below it at every `x`.
+    fn point_distance_gradient(&self, p: &Vector3) -> (Real, Vector3) {
+        let local = self.rotation.tr_mul(&(p - self.body.center));
+        let sign = local.map(|x| if x < 0.0 { -1.0 } else { 1.0 });
+        let (distance, gradient) = match self.solid {
+            Solid::Cuboid { half } => {
+                let d = local.abs() - half;
+                let outside = d.sup(&Vector3::zeros());
+                let norm = outside.norm();
+                if norm > 0.0 {
+                    (norm, outside.component_mul(&sign) / norm)
+                } else {
+                    // Inside: the nearest face's plane.
+                    let k = d.imax();
+                    (d[k], Vector3::ith(k, sign[k]))
+                }
+            }
+            Solid::Cylinder { radius, half_height } => {
+                let length = local.x.hypot(local.y);
+                // On the axis any horizontal unit vector is a subgradient of the radial part.
+                let out = if length > 0.0 {
+                    Vector3::new(local.x / length, local.y / length, 0.0)
+                } else {
+                    Vector3::x()
+                };
+                let up = Vector3::new(0.0, 0.0, sign.z);
+                let (radial, axial) = (length - radius, local.z.abs() - half_height);
+                if radial > 0.0 && axial > 0.0 {
+                    let d = radial.hypot(axial);
+                    (d, (out * radial + up * axial) / d)
+                } else if radial >= axial {
+                    (radial, out)
+                } else {
+                    (axial, up)
+                }
+            }
+        };
+        (distance, self.rotation * gradient)
+    }
+
+    /// A lower bound of the signed distance from the segment a–b to the solid, within
+    /// [`SEGMENT_TOLERANCE`] of it, if below `below`; `None` when it is not. A segment that
+    /// enters the solid, or one whose bracket does not close within 64 steps, is parry's;
+    /// the rest is settled in closed form.
+    ///
+    /// Along the segment the signed distance f(t) is convex, so the tangents at the ends of a
+    /// bracket [lo, hi] of its minimum (f′(lo) < 0 < f′(hi)) meet below it: their crossing is a
+    /// lower bound, the smaller end an upper one, and the crossing is where the bracket is
+    /// split next (a secant step on f′). Most pairs end at the first crossing, above `below`.
+    fn segment_distance(&self, a: &Vector3, b: &Vector3, below: Real) -> Option<Real> {
+        let along = b - a;
+        let at = |t: Real| {
+            let (f, g) = self.point_distance_gradient(&(a + along * t));
+            (f, g.dot(&along))
+        };
+        let ((mut f_lo, mut g_lo), (mut f_hi, mut g_hi)) = (at(0.0), at(1.0));
+        let (mut lo, mut hi) = (0.0, 1.0);
+        let exact = |f: Real| (f < below).then_some(f);
+        // A slope that does not descend into the segment puts the minimum at an end.
+        if g_lo >= 0.0 && f_lo > 0.0 {
+            return exact(f_lo);
+        }
+        if g_hi <= 0.0 && f_hi > 0.0 {
+            return exact(f_hi);
+        }
+        let mut upper = f_lo.min(f_hi);
+        // Which end of the bracket moved last: a secant step that keeps moving the same end
+        // converges slowly (as regula falsi does), so then the bracket is halved.
+        let (mut moved_lo, mut halve) = (None, false);
+        for _ in 0..64 {
+            if upper <= 0.0 {
+                break;
+            }
+            let width = hi - lo;
+            let crossing = (f_hi - f_lo + g_lo * lo - g_hi * hi) / (g_lo - g_hi);
+            let lower = (f_lo + g_lo * (crossing - lo)).min(upper) - ROUNDING;
+            // Only a bound at or above zero is settled this way: below it the answer is a
+            // depth, and parry's penetration depth of a segment is not the deepest point's.
+            if lower >= below && below >= 0.0 {
+                return None;
+            }
+            if upper - lower <= SEGMENT_TOLERANCE {
+                return (lower < below).then_some(lower);
+            }
+            if width <= Real::EPSILON {
+                break;
+            }
+            // Kept off the ends, so that the bracket shrinks whatever the slopes.
+            let t = if halve || !crossing.is_finite() {
+                lo + 0.5 * width
+            } else {
+                crossing.clamp(lo + 0.01 * width, hi - 0.01 * width)
+            };
+            let (f, g) = at(t);
+            upper = upper.min(f);
+            if g == 0.0 && f > 0.0 {
+                return exact(f);
+            }
+            let side = g < 0.0;
+            if side {
+                (lo, f_lo, g_lo) = (t, f, g);
+            } else {
+                (hi, f_hi, g_hi) = (t, f, g);
+            }
+            halve = moved_lo == Some(side);
+            moved_lo = Some(side);
+        }
+        // The segment enters the solid, or the bracket did not close to the tolerance (a
+        // secant that alternates ends near an edge or a rim shrinks it slowly): parry's exact
+        // distance or depth, so that the answer is never further than the tolerance below it.
+        let posed = Posed::new(*a, *b, 0.0);
+        posed.convex_distance(&self.body, below).filter(|&d| d < below)
     }
 }
 
@@ -395,7 +518,11 @@ impl CollisionModel {
             }
             for convex in &self.convex {
                 let body = &convex.body;
-                if (center - body.center).norm() - group.bound - body.bound >= near {
+                // The bounding spheres first, then the solid's own distance from the group's
+                // centre: a long thin shelf's bounding sphere says little.
+                if (center - body.center).norm() - group.bound - body.bound >= near
+                    || convex.point_distance(&center) - group.bound >= near
+                {
                     continue;
                 }
                 for m in 0..n {
@@ -404,11 +531,14 @@ impl CollisionModel {
                     if gap >= below[m] - link.radius {
                         continue;
                     }
+                    let half_length = link.bound - link.radius;
                     let distance = if link.inverse_squared_length == 0.0 {
-                        // A sphere: the exact point distance, without parry's machinery.
+                        // A sphere: the exact point distance.
                         Some(convex.point_distance(&link.a))
+                    } else if convex.point_distance(&link.center) - half_length >= below[m] {
+                        continue;
                     } else {
-                        link.convex_distance(body, below[m])
+                        convex.segment_distance(&link.a, &link.b, below[m])
                     };
                     if let Some(distance) = distance {
                         if distance < below[m] {

@@ -149,3 +149,98 @@ fn point_distances_to_solids_match_parry() {
         assert!((found - expected).abs() < 1e-7, "{k}: {found} vs {expected}");
     }
 }
+
+/// The closed-form distance from a segment to a turned box or cylinder: a lower bound within
+/// [`SEGMENT_TOLERANCE`] of parry's where the segment stays outside, `None` exactly when that
+/// distance is not below the bound asked for, and parry's depth where it enters.
+#[test]
+fn segment_distances_to_solids_match_parry() {
+    use crate::language::{Obstacle, Shape};
+    let path = format!("{}/../../robots/panda.urdf", env!("CARGO_MANIFEST_DIR"));
+    let robot = Robot::from_urdf_file(path).expect("robot loads");
+    let mut rng = rand::rngs::StdRng::seed_from_u64(19);
+    let mut number = |lo: Real, hi: Real| rng.random_range(lo..hi);
+    let (mut outside, mut entering, mut refused) = (0, 0, 0);
+    let mut worst_parry: Real = 0.0;
+    for k in 0..4000 {
+        let center = v(number(-1.0, 1.0), number(-1.0, 1.0), number(-1.0, 1.0));
+        let rotation =
+            Rotation3::from_euler_angles(number(-PI, PI), number(-PI, PI), number(-PI, PI));
+        let shape = if k % 2 == 0 {
+            // Thin boards too, as the shelves of the MotionBenchMaker scenes.
+            let size = v(number(0.005, 0.8), number(0.05, 1.2), number(0.05, 0.8));
+            Shape::Box { center, size, rotation }
+        } else {
+            Shape::Cylinder {
+                center,
+                radius: number(0.02, 0.4),
+                height: number(0.05, 0.8),
+                rotation,
+            }
+        };
+        let scene = CollisionScene::new(&[Obstacle { name: "solid".into(), shape }]);
+        let model = CollisionModel::new(&robot, &scene);
+        let convex = &model.convex[0];
+        let a = center + v(number(-0.7, 0.7), number(-0.7, 0.7), number(-0.7, 0.7));
+        // Every fourth segment parallel to a face or the axis, where the minimum is a plateau.
+        let b = if k % 4 == 1 {
+            a + convex.rotation.column(k % 3) * number(-0.4, 0.4)
+        } else {
+            a + v(number(-0.4, 0.4), number(-0.4, 0.4), number(-0.4, 0.4))
+        };
+        let segment = Segment::new(to_parry(&a), to_parry(&b));
+        let expected = query::contact(
+            &convex.body.pose,
+            convex.body.shape.as_dyn(),
+            &Pose::IDENTITY,
+            &segment,
+            10.0,
+        )
+        .expect("supported")
+        .expect("within the prediction")
+        .dist;
+        let found = convex.segment_distance(&a, &b, Real::INFINITY).expect("below ∞");
+        if expected > 1e-9 {
+            outside += 1;
+            // parry's GJK stops up to ~1e-5 m above a cylinder's true distance, so the
+            // reference outside is the exact point distance minimised along the segment.
+            let brute = brute_segment_distance(convex, &a, &b);
+            assert!(found <= brute + 1e-10, "{k}: {found} above {brute}");
+            assert!(found >= brute - 1e-10, "{k}: {found} far below {brute}");
+            assert!(expected >= brute - 1e-9, "{k}: parry {expected} below {brute}");
+            worst_parry = worst_parry.max(expected - brute);
+        } else if expected < -1e-9 {
+            entering += 1;
+            assert!((found - expected).abs() < 1e-9, "{k}: {found} vs {expected}");
+        }
+        // A bound above the distance keeps it; one below it is refused.
+        let bound = expected + number(-0.05, 0.05);
+        match convex.segment_distance(&a, &b, bound) {
+            Some(d) => assert!(d < bound && (d - found).abs() < 1e-9, "{k}: {d} for {bound}"),
+            None => {
+                refused += 1;
+                assert!(expected >= bound - 1e-9, "{k}: refused {expected} below {bound}")
+            }
+        }
+    }
+    assert!(outside > 1000 && entering > 100 && refused > 500, "{outside} {entering} {refused}");
+    // Why the reference is not parry: its distance to some cylinders is this far above.
+    assert!(worst_parry > 1e-7, "parry agrees with the exact distance to {worst_parry}");
+}
+
+/// The distance from the segment a–b to a solid outside it, independently of the tangent
+/// search: the exact point distance sampled densely along the segment, then a golden-section
+/// search (the distance is convex along it) in the best sample's neighbourhood.
+fn brute_segment_distance(convex: &Convex, a: &Vector3, b: &Vector3) -> Real {
+    let f = |t: Real| convex.point_distance(&(a + (b - a) * t));
+    let n = 4000;
+    let best = (0..=n).map(|i| i as Real / n as Real).min_by(|&s, &t| f(s).total_cmp(&f(t)));
+    let best = best.expect("samples");
+    let step = 1.0 / n as Real;
+    let (mut lo, mut hi) = ((best - step).max(0.0), (best + step).min(1.0));
+    for _ in 0..100 {
+        let (m1, m2) = (lo + (hi - lo) * 0.382, lo + (hi - lo) * 0.618);
+        if f(m1) < f(m2) { hi = m2 } else { lo = m1 }
+    }
+    f(best).min(f(0.5 * (lo + hi)))
+}
