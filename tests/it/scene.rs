@@ -171,7 +171,14 @@ fn rotated_boxes_and_cylinders_match_brute_force() {
         let empty = CollisionModel::new(&robot, &CollisionScene::new(&[]));
         let self_only = clearance(&empty, &q);
         let expected = smallest.min(self_only);
-        assert!((arm_only - expected).abs() < 1e-9, "{k}: {arm_only} vs {expected}");
+        // The model's capsule-cylinder distance is closed form (within 1e-11 m of the true
+        // one), parry's GJK above it by up to 2e-5 m (as above): the model may be below parry
+        // by that much, never above.
+        let below = if k % 2 == 0 { 1e-9 } else { 2e-5 };
+        assert!(
+            arm_only < expected + 1e-9 && arm_only > expected - below,
+            "{k}: {arm_only} vs {expected}"
+        );
     }
     assert!(close > 20, "too few close pairs exercised: {close}");
 }

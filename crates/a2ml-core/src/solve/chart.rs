@@ -148,10 +148,9 @@ impl Chart {
         match (a, b) {
             (Target::Position(a), Target::Position(b)) => (a - b).norm() * self.position_scale,
             (Target::Rotation(a), Target::Rotation(b)) => rotation_distance(a, b),
-            (Target::Angle(a), Target::Angle(b)) if self.variables[k] == Variable::Swivel => {
-                wrap_angle(b - a).abs()
+            (Target::Angle(a), Target::Angle(b)) => {
+                self.variables[k].angle_difference(*b, *a).abs()
             }
-            (Target::Angle(a), Target::Angle(b)) => (b - a).abs(),
             _ => Real::INFINITY,
         }
     }
@@ -164,10 +163,11 @@ impl Chart {
             (Target::Rotation(r), Target::Rotation(s)) => {
                 Target::Rotation(r * Rotation3::new(rotation_log(&(r.inverse() * s)) * tau))
             }
-            (Target::Angle(x), Target::Angle(y)) if self.variables[k] == Variable::Swivel => {
-                Target::Angle(wrap_angle(x + wrap_angle(y - x) * tau))
+            (Target::Angle(x), Target::Angle(y)) => {
+                let variable = self.variables[k];
+                let at = x + variable.angle_difference(y, x) * tau;
+                Target::Angle(if variable.wraps() { wrap_angle(at) } else { at })
             }
-            (Target::Angle(x), Target::Angle(y)) => Target::Angle(x + (y - x) * tau),
             (value, _) => value,
         });
         self.at(a.sigma + (b.sigma - a.sigma) * tau, &free)
