@@ -110,26 +110,13 @@ fn capsules_move_within_their_motion_bounds() {
 /// outside and inside.
 #[test]
 fn point_distances_to_solids_match_parry() {
-    use crate::language::{Obstacle, Shape};
+    use crate::language::Obstacle;
     let path = format!("{}/../../robots/panda.urdf", env!("CARGO_MANIFEST_DIR"));
     let robot = Robot::from_urdf_file(path).expect("robot loads");
     let mut rng = rand::rngs::StdRng::seed_from_u64(17);
     let mut number = |lo: Real, hi: Real| rng.random_range(lo..hi);
     for k in 0..2000 {
-        let center = v(number(-1.0, 1.0), number(-1.0, 1.0), number(-1.0, 1.0));
-        let rotation =
-            Rotation3::from_euler_angles(number(-PI, PI), number(-PI, PI), number(-PI, PI));
-        let shape = if k % 2 == 0 {
-            let size = v(number(0.05, 0.8), number(0.05, 0.8), number(0.05, 0.8));
-            Shape::Box { center, size, rotation }
-        } else {
-            Shape::Cylinder {
-                center,
-                radius: number(0.02, 0.4),
-                height: number(0.05, 0.8),
-                rotation,
-            }
-        };
+        let (center, shape) = random_solid(&mut number, k, [(0.05, 0.8); 3]);
         let scene = CollisionScene::new(&[Obstacle { name: "solid".into(), shape }]);
         let model = CollisionModel::new(&robot, &scene);
         let convex = &model.convex[0];
@@ -155,7 +142,7 @@ fn point_distances_to_solids_match_parry() {
 /// distance is not below the bound asked for, and parry's depth where it enters.
 #[test]
 fn segment_distances_to_solids_match_parry() {
-    use crate::language::{Obstacle, Shape};
+    use crate::language::Obstacle;
     let path = format!("{}/../../robots/panda.urdf", env!("CARGO_MANIFEST_DIR"));
     let robot = Robot::from_urdf_file(path).expect("robot loads");
     let mut rng = rand::rngs::StdRng::seed_from_u64(19);
@@ -163,21 +150,9 @@ fn segment_distances_to_solids_match_parry() {
     let (mut outside, mut entering, mut refused) = (0, 0, 0);
     let mut worst_parry: Real = 0.0;
     for k in 0..4000 {
-        let center = v(number(-1.0, 1.0), number(-1.0, 1.0), number(-1.0, 1.0));
-        let rotation =
-            Rotation3::from_euler_angles(number(-PI, PI), number(-PI, PI), number(-PI, PI));
-        let shape = if k % 2 == 0 {
-            // Thin boards too, as the shelves of the MotionBenchMaker scenes.
-            let size = v(number(0.005, 0.8), number(0.05, 1.2), number(0.05, 0.8));
-            Shape::Box { center, size, rotation }
-        } else {
-            Shape::Cylinder {
-                center,
-                radius: number(0.02, 0.4),
-                height: number(0.05, 0.8),
-                rotation,
-            }
-        };
+        // Thin boards too, as the shelves of the MotionBenchMaker scenes.
+        let (center, shape) =
+            random_solid(&mut number, k, [(0.005, 0.8), (0.05, 1.2), (0.05, 0.8)]);
         let scene = CollisionScene::new(&[Obstacle { name: "solid".into(), shape }]);
         let model = CollisionModel::new(&robot, &scene);
         let convex = &model.convex[0];
@@ -243,4 +218,24 @@ fn brute_segment_distance(convex: &Convex, a: &Vector3, b: &Vector3) -> Real {
         if f(m1) < f(m2) { hi = m2 } else { lo = m1 }
     }
     f(best).min(f(0.5 * (lo + hi)))
+}
+
+/// A turned solid about the origin: a box (even `k`, its sides drawn from `box_sides`) or a
+/// cylinder (odd `k`); its centre and its shape.
+fn random_solid(
+    number: &mut impl FnMut(Real, Real) -> Real,
+    k: usize,
+    box_sides: [(Real, Real); 3],
+) -> (Vector3, crate::language::Shape) {
+    use crate::language::Shape;
+    let center = v(number(-1.0, 1.0), number(-1.0, 1.0), number(-1.0, 1.0));
+    let rotation = Rotation3::from_euler_angles(number(-PI, PI), number(-PI, PI), number(-PI, PI));
+    let shape = if k % 2 == 0 {
+        let [x, y, z] = box_sides;
+        let size = v(number(x.0, x.1), number(y.0, y.1), number(z.0, z.1));
+        Shape::Box { center, size, rotation }
+    } else {
+        Shape::Cylinder { center, radius: number(0.02, 0.4), height: number(0.05, 0.8), rotation }
+    };
+    (center, shape)
 }
