@@ -8,7 +8,7 @@
 //! side). Rows are computed on the calling thread: a caller who wants more threads splits the
 //! batch, which the released GIL lets run in parallel, with the same bits per row.
 
-use a2ml_core::kinematics::{self, ArmPose, CpsaState, KinematicsError};
+use a2ml_core::kinematics::{self, ArmPose, BatchedChain, CpsaState, KinematicsError};
 use a2ml_core::math::{DOF, Jacobian6x7, JointVector, Matrix3, Real, Vector3};
 use numpy::{
     AllowTypeChange, IntoPyArray, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyReadwriteArrayDyn,
@@ -214,6 +214,29 @@ impl OnError {
     }
 }
 
+impl PyRobot {
+    /// `kernel` over the rows of `q` (N, 7), each writing one row of shape `row` into `out`
+    /// (or a new (N, *row) array), with the GIL released: the input is read in place and the
+    /// kernel writes straight into the output array.
+    fn each_row<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
+        row: &[usize],
+        kernel: impl FnOnce(&BatchedChain, &[Real], &mut [Real]) + Send,
+    ) -> PyResult<Array<'py>> {
+        let rows = read_rows(q, "q", &[DOF])?;
+        let shape: Vec<usize> = std::iter::once(rows.count).chain(row.iter().copied()).collect();
+        let result = output(py, out, "out", &shape)?;
+        let mut guard = writer(&result, "out")?;
+        let (values, slots) = (rows.values(), slots(&mut guard));
+        py.detach(|| kernel(&self.chain, values, slots));
+        drop(guard);
+        Ok(result)
+    }
+}
+
 #[pymethods]
 impl PyRobot {
     /// The hand frame {W} (4x4) and J_ge (6x7) at `q` from one FK, written into
@@ -244,14 +267,7 @@ impl PyRobot {
         q: &Bound<'py, PyAny>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Array<'py>> {
-        let rows = read_rows(q, "q", &[DOF])?;
-        let result = output(py, out, "out", &[rows.count, 4, 4])?;
-        let mut guard = writer(&result, "out")?;
-        let (values, out) = (rows.values(), slots(&mut guard));
-        let chain = kinematics::BatchedChain::new(&self.robot);
-        py.detach(|| chain.hand_frames(values, out));
-        drop(guard);
-        Ok(result)
+        self.each_row(py, q, out, &[4, 4], BatchedChain::hand_frames)
     }
 
     /// J_ge at each row of `q` (N, 7), as (N, 6, 7).
@@ -262,14 +278,7 @@ impl PyRobot {
         q: &Bound<'py, PyAny>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Array<'py>> {
-        let rows = read_rows(q, "q", &[DOF])?;
-        let result = output(py, out, "out", &[rows.count, 6, DOF])?;
-        let mut guard = writer(&result, "out")?;
-        let (values, out) = (rows.values(), slots(&mut guard));
-        let chain = kinematics::BatchedChain::new(&self.robot);
-        py.detach(|| chain.jacobians(values, out));
-        drop(guard);
-        Ok(result)
+        self.each_row(py, q, out, &[6, DOF], BatchedChain::jacobians)
     }
 
     /// The CPSA state at each row of `q` (N, 7): pw (N, 3), ow (N, 3, 3), swivel (N,).
@@ -290,10 +299,9 @@ impl PyRobot {
         let values = rows.values();
         let (pw_out, ow_out, swivel_out) =
             (slots(&mut pw_guard), slots(&mut ow_guard), slots(&mut swivel_guard));
-        let chain = kinematics::BatchedChain::new(&self.robot);
         let failed = py.detach(|| {
             let mut failed = None;
-            chain.cpsa_states(&self.robot, values, |i, state| match state {
+            self.chain.cpsa_states(&self.robot, values, |i, state| match state {
                 Ok(s) if failed.is_none() => {
                     pw_out[3 * i..3 * i + 3].copy_from_slice(s.pw.as_slice());
                     let r = s.ow.matrix();

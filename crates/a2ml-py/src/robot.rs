@@ -21,6 +21,8 @@ use crate::errors::CoreError;
 #[pyclass(frozen, module = "a2ml", name = "Robot")]
 pub(crate) struct PyRobot {
     pub(crate) robot: a2ml_core::Robot,
+    /// The batched FK kernel of `robot`, built once for every batched call.
+    pub(crate) chain: kinematics::BatchedChain,
     base: Option<String>,
     tip: Option<String>,
 }
@@ -31,7 +33,12 @@ impl PyRobot {
     pub(crate) fn of_task(py: Python<'_>, task: &a2ml_core::language::Task) -> PyResult<Self> {
         let robot = py.detach(|| task.load_robot(&RobotOptions::default()));
         let (base, tip) = (task.robot_base.clone(), task.robot_tip.clone());
-        Ok(Self { robot: robot.map_err(CoreError::from)?, base, tip })
+        Ok(Self::new(robot.map_err(CoreError::from)?, base, tip))
+    }
+
+    fn new(robot: a2ml_core::Robot, base: Option<String>, tip: Option<String>) -> Self {
+        let chain = kinematics::BatchedChain::new(&robot);
+        Self { robot, chain, base, tip }
     }
 
     fn options(base: &Option<String>, tip: &Option<String>) -> RobotOptions {
@@ -60,7 +67,7 @@ impl PyRobot {
     ) -> PyResult<Self> {
         let robot = a2ml_core::Robot::from_urdf_file_with(&path, &Self::options(&base, &tip))
             .map_err(CoreError::from)?;
-        Ok(Self { robot, base, tip })
+        Ok(Self::new(robot, base, tip))
     }
 
     /// Reads a URDF document given as a string.
@@ -74,7 +81,7 @@ impl PyRobot {
     ) -> PyResult<Self> {
         let robot = a2ml_core::Robot::from_urdf_str(&text, &Self::options(&base, &tip))
             .map_err(CoreError::from)?;
-        Ok(Self { robot, base, tip })
+        Ok(Self::new(robot, base, tip))
     }
 
     /// Pickles as `Robot.from_urdf_string(urdf, base, tip)`.
