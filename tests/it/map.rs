@@ -192,7 +192,8 @@ fn paper_scenario_derived_numbers() {
         assert!((closest * 1e3 - expected).abs() < 0.05, "{}: {:.3} mm", o.name, closest * 1e3);
     }
     // METHODS.md §1.6: Δ1, Δ2 at ρ = 0 and ρ = 5 mm, and the phase of O2 from O1.
-    let table: [(Real, Real, Option<Real>, Real, Option<Real>, Real); 11] = [
+    type Row = (Real, Real, Option<Real>, Real, Option<Real>, Real);
+    let table: [Row; 11] = [
         (0.0, 26.7, None, 42.1, None, -12.5),
         (0.5, 33.5, None, 48.7, None, -12.7),
         (1.0, 42.0, None, 56.9, None, -12.2),
@@ -306,7 +307,7 @@ fn every_cell_matches_a_direct_check() {
         }
     }
     assert!(forbidden > nt * n / 10, "the scene forbids too little to test: {forbidden}");
-    assert!(map.cells.iter().any(|c| *c == a2ml::solve::map::Cell::Obstacle(2)), "the box shows");
+    assert!(map.cells.contains(&a2ml::solve::map::Cell::Obstacle(2)), "the box shows");
     assert!(
         (mismatched as Real) < 0.02 * boundary as Real,
         "{mismatched} of {boundary} boundary cells disagree"

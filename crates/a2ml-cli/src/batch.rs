@@ -261,7 +261,7 @@ mod tests {
         let planning = CliError::Planning("p".into());
         let input = CliError::Input("i".into());
         assert_eq!(finish(3, &[], 0.0), Ok(()));
-        assert!(matches!(finish(3, &[missed.clone()], 0.0), Err(CliError::Missed(_))));
+        assert!(matches!(finish(3, std::slice::from_ref(&missed), 0.0), Err(CliError::Missed(_))));
         let both = [missed.clone(), planning.clone()];
         assert!(matches!(finish(3, &both, 0.0), Err(CliError::Planning(_))));
         let all = [missed, input, planning];

@@ -10,7 +10,8 @@
 //! baseline, joined and checked), [`trajectory`] (sampled joint trajectories,
 //! their joining and limit checks), [`metrics`] (human-likeness measures) and
 //! [`output`] (MCAP, CSV, JSON, Parquet, SVG and HTML). [`math`] fixes the scalar
-//! type and aliases, [`names`] suggests names, [`error`] wraps each module's error.
+//! type and aliases, [`names`] suggests names, [`spelling`] gives every enum its one
+//! spelling, [`error`] wraps each module's error.
 
 pub mod collision;
 pub mod decompose;

@@ -279,10 +279,10 @@ mod tests {
         assert_eq!(types, ["i", "ii", "iii", "iv", "v", "vi", "vii"]);
         let variables = spellings::<crate::language::Variable>();
         assert_eq!(variables, ["pw", "ow", "swivel", "shoulder_frame", "elbow"]);
-        let space: crate::language::Space = "hat".parse().unwrap();
+        let space: crate::language::Space = "hat".parse().expect("`hat` is a space");
         assert_eq!(space.to_string(), "hat");
-        assert_eq!(serde_json::to_string(&space).unwrap(), "\"hat\"");
-        let e = "HAT".parse::<crate::language::Space>().unwrap_err();
+        assert_eq!(serde_json::to_string(&space).expect("a space serializes"), "\"hat\"");
+        let e = "HAT".parse::<crate::language::Space>().expect_err("spellings are lower case");
         assert_eq!(e.to_string(), "unknown space `HAT` (expected one of: cpsa, hat)");
     }
 }

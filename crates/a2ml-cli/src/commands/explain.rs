@@ -654,7 +654,7 @@ fn relaxed(variables: &[&str]) -> String {
 
 /// The paper's symbol of a variable given in its spelling (`swivel` -> `θsw`): the text
 /// report reads as A2ML, the JSON carries the spelling.
-fn symbol<'a>(spelling: &'a str) -> &'a str {
+fn symbol(spelling: &str) -> &str {
     spelling.parse::<Variable>().map_or(spelling, |v| v.symbol())
 }
 

@@ -15,7 +15,9 @@ use crate::kinematics::{
     CpsaState, HatState, KinematicsError, arm_pose, cpsa_state, cpsa_to_hat, hat_state,
     hat_to_cpsa, ik_cpsa, ik_cpsa_nearest, swivel_intervals,
 };
-use crate::language::{Axis, BodyAxis, PathConstraint, PathFeature, Space, Target, Variable};
+use crate::language::{
+    Axis, BodyAxis, Measure, PathConstraint, PathFeature, Space, Target, Variable,
+};
 use crate::math::{
     DOF, JointVector, PI, Real, Rotation3, Vector3, rotation_about, rotation_log, wrap_angle,
 };
@@ -150,7 +152,10 @@ impl Default for OptOptions {
             max_path_size: 1.0,
             swivel_samples: 72,
             clearance: 0.01,
-            goal_tolerance: (1e-3, (1.0 as Real).to_radians()),
+            goal_tolerance: (
+                Measure::Length.default_tolerance(),
+                Measure::Angle.default_tolerance(),
+            ),
             limit_margin: 1e-3,
         }
     }
@@ -434,9 +439,11 @@ impl Search<'_> {
             for v in &self.free {
                 for d in 0..v.dimension() {
                     let u = halton(k, i + d) * 2.0 - 1.0;
-                    x[i + d] = match v {
-                        Variable::Pw => 0.15 * u,
-                        _ => 0.9 * PI * u / (v.dimension() as Real).sqrt(),
+                    // A position spreads over a hand's reach (0.15 m); a rotation or an angle
+                    // over most of a half turn, shared among its rows.
+                    x[i + d] = match v.measure() {
+                        Measure::Length => 0.15 * u,
+                        Measure::Angle => 0.9 * PI * u / (v.dimension() as Real).sqrt(),
                     };
                 }
                 i += v.dimension();

@@ -41,6 +41,21 @@ impl Measure {
             Measure::Angle => "°",
         }
     }
+
+    /// The decimals a message shows by default: tenths of a millimetre, hundredths of a
+    /// degree, finer than either default tolerance.
+    pub fn decimals(self) -> usize {
+        match self {
+            Measure::Length => 1,
+            Measure::Angle => 2,
+        }
+    }
+
+    /// `value` (m or rad) as a user reads it, `decimals` shown: `0.42 mm`, `0.31°`.
+    pub fn text(self, value: Real, decimals: usize) -> String {
+        // + 0.0 turns -0 into 0, so no `-0.00` is shown.
+        format!("{:.decimals$}{}", self.shown(value) + 0.0, self.shown_unit())
+    }
 }
 
 impl Variable {
@@ -56,9 +71,7 @@ impl Variable {
     /// An error of the variable as a user reads it, `decimals` shown: `pw 0.42 mm`,
     /// `swivel 0.31°`.
     pub fn error_text(self, error: Real, decimals: usize) -> String {
-        let measure = self.measure();
-        // + 0.0 turns -0 into 0, so no `-0.00` is shown.
-        format!("{self} {:.decimals$}{}", measure.shown(error) + 0.0, measure.shown_unit())
+        format!("{self} {}", self.measure().text(error, decimals))
     }
 
     /// Whether the variable's value is an angle taken modulo a turn: θsw is (an arm plane
@@ -192,5 +205,7 @@ mod tests {
         assert!((Measure::Angle.shown(Measure::Angle.default_tolerance()) - 1.0).abs() < 1e-12);
         assert_eq!(Variable::Pw.error_text(0.42e-3, 2), "pw 0.42 mm");
         assert_eq!(Variable::Swivel.error_text(0.31_f64.to_radians(), 2), "swivel 0.31°");
+        assert_eq!(Measure::Length.text(-0.0, 1), "0.0 mm");
+        assert_eq!(Measure::Angle.text(1.5_f64.to_radians(), Measure::Angle.decimals()), "1.50°");
     }
 }

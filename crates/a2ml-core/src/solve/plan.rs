@@ -1209,10 +1209,8 @@ fn left_path(s: &SegmentReport) -> Warning {
 
 /// "Pw by 3.1 mm", "θsw by 2.00°".
 fn describe(e: &VariableError) -> String {
-    match e.variable {
-        Variable::Pw => format!("Pw by {:.1} mm", e.error * 1e3),
-        v => format!("{} by {:.2}°", v.symbol(), e.error.to_degrees()),
-    }
+    let measure = e.variable.measure();
+    format!("{} by {}", e.variable.symbol(), measure.text(e.error, measure.decimals()))
 }
 
 /// The warning for a segment whose output exceeds a joint limit: the speed ratios, and each
