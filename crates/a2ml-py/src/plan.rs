@@ -30,12 +30,17 @@ use crate::{CoreError, Matrix, PyRobot, Vector, to_vector};
 
 type Dict<'py> = Bound<'py, PyDict>;
 
+/// A robot file and its chain's `base` and `tip`: the key of a robot loaded once per batch.
+type RobotKey = (PathBuf, Option<String>, Option<String>);
+
 /// Plans a task, or the task file at a path, on its robot (or `robot`), releasing the GIL.
 #[pyfunction]
 #[pyo3(signature = (
     task_or_path, solver=None, rate=None, seed=None, robot=None, acceleration_scale=None,
     time_limit=None
 ))]
+// One argument per Python keyword: the signature is the Python API.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn plan(
     py: Python<'_>,
     task_or_path: &Bound<'_, PyAny>,
@@ -70,6 +75,8 @@ pub(crate) fn plan(
     tasks, robot=None, jobs=None, solver=None, rate=None, seed=None, acceleration_scale=None,
     time_limit=None
 ))]
+// One argument per Python keyword: the signature is the Python API.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn plan_many(
     py: Python<'_>,
     tasks: &Bound<'_, PyAny>,
@@ -85,8 +92,7 @@ pub(crate) fn plan_many(
         return Err(PyValueError::new_err("jobs must be at least 1"));
     }
     let options = plan_options(solver, rate, acceleration_scale, time_limit)?;
-    let mut robots: HashMap<(PathBuf, Option<String>, Option<String>), PyResult<Py<PyRobot>>> =
-        HashMap::new();
+    let mut robots: HashMap<RobotKey, PyResult<Py<PyRobot>>> = HashMap::new();
     let mut entries: Vec<PyResult<(Bound<'_, PyTask>, Py<PyRobot>)>> = Vec::new();
     for item in tasks.try_iter()? {
         let item = item?;
