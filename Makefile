@@ -57,11 +57,19 @@ build:
 COMPARE_VENV    := .venv-compare
 COMPARE_PY      := $(COMPARE_VENV)/bin/python
 COMPARE_REQS    := benches/compare/requirements.txt
+# Peers that may not install here (vamp-planner, ompl): each line tried on its own, a
+# failure reported and skipped; the script of that peer then runs without it.
+COMPARE_OPTIONAL := benches/compare/requirements-optional.txt
 COMPARE_SCRIPTS := $(wildcard benches/compare/kinematics.py benches/compare/rrt.py)
 
-$(COMPARE_VENV)/.tools-installed: $(COMPARE_REQS)
+$(COMPARE_VENV)/.tools-installed: $(COMPARE_REQS) $(COMPARE_OPTIONAL)
 	$(PYTHON) -m venv $(COMPARE_VENV)
 	$(COMPARE_PY) -m pip install --quiet --disable-pip-version-check -r $(COMPARE_REQS)
+	@grep -v '^[[:space:]]*\(#\|$$\)' $(COMPARE_OPTIONAL) | while read -r peer; do \
+	  if $(COMPARE_PY) -m pip install --quiet --disable-pip-version-check --only-binary :all: "$$peer" >/dev/null 2>&1; \
+	  then echo "compare: optional peer $$peer installed"; \
+	  else echo "compare: optional peer $$peer does not install here; its comparison is skipped"; fi; \
+	done
 	touch $@
 
 $(COMPARE_VENV)/.wheel-installed: $(COMPARE_VENV)/.tools-installed $(PY_INPUTS)
