@@ -225,3 +225,51 @@ def test_threads_share_a_batch() -> None:
     for t in threads:
         t.join()
     np.testing.assert_array_equal(np.concatenate(results), expected)
+
+
+# A batch of 256 rows or more is cut in two halves run on two threads (src/batch.rs).
+LARGE = 601
+
+
+@pytest.mark.parametrize("name", ["iiwa14", "panda"])
+def test_a_large_batch_split_over_threads_gives_the_bits_of_small_batches(name: str) -> None:
+    r = robot(name)
+    qs = configurations(r, LARGE, seed=5)
+    frames, jacobians = r.fk_many(qs), r.jacobian_many(qs)
+    pw, ow, swivel = r.cpsa_many(qs)
+    solved = r.ik_cpsa_many(pw, ow, swivel, qs)
+    for start in range(0, LARGE, 100):
+        rows = slice(start, min(start + 100, LARGE))
+        np.testing.assert_array_equal(r.fk_many(qs[rows]), frames[rows])
+        np.testing.assert_array_equal(r.jacobian_many(qs[rows]), jacobians[rows])
+        p, o, s = r.cpsa_many(qs[rows])
+        np.testing.assert_array_equal(p, pw[rows])
+        np.testing.assert_array_equal(o, ow[rows])
+        np.testing.assert_array_equal(s, swivel[rows])
+        np.testing.assert_array_equal(
+            r.ik_cpsa_many(pw[rows], ow[rows], swivel[rows], qs[rows]), solved[rows]
+        )
+    # Every row is written, none left as the zeros of a new array.
+    assert np.all(frames[:, 3, 3] == 1.0) and np.all(np.abs(jacobians[:, 3:]).sum(axis=1) > 0)
+
+
+def test_a_large_batch_reports_its_first_failing_row_whichever_half_it_is_in() -> None:
+    r = robot("iiwa14")
+    qs = configurations(r, LARGE, seed=6)
+    pw, ow, swivel = r.cpsa_many(qs)
+    far = pw.copy()
+    far[[450, 580]] *= 10.0  # both in the second half
+    with pytest.raises(UnreachableError, match="^row 450: "):
+        r.ik_cpsa_many(far, ow, swivel, qs)
+    far[17] *= 10.0  # and one in the first
+    with pytest.raises(UnreachableError, match="^row 17: "):
+        r.ik_cpsa_many(far, ow, swivel, qs)
+    solved = r.ik_cpsa_many(far, ow, swivel, qs, on_error="nan")
+    assert np.isnan(solved[[17, 450, 580]]).all() and not np.isnan(np.delete(solved, [17, 450, 580], 0)).any()
+    straight = qs.copy()
+    straight[[400, 500], 3] = 0.0  # the elbow straight in the second half
+    with pytest.raises(SingularityError, match="^row 400: "):
+        r.cpsa_many(straight)
+    straight[3, 3] = 0.0
+    with pytest.raises(SingularityError, match="^row 3: "):
+        r.cpsa_many(straight)

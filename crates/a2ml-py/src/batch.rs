@@ -5,8 +5,10 @@
 //! float64 arrays in place (any other array-like is converted once), write into arrays the
 //! caller passes (`out=`) or into one array made for the result, and run the rows with the
 //! GIL released, by the core's batched kernel (`kinematics::BatchedChain`: several rows side by
-//! side). Rows are computed on the calling thread: a caller who wants more threads splits the
-//! batch, which the released GIL lets run in parallel, with the same bits per row.
+//! side). A batch of at least [`PARALLEL_ROWS`] rows is cut in two halves run at once on
+//! rayon's pool (the machine's cores): a row's result never depends on the other rows, so the
+//! bits are the same as on one thread; a smaller batch runs on the calling thread, where the
+//! hand-over would cost more than it saves.
 
 use a2ml_core::kinematics::{self, ArmPose, BatchedChain, CpsaState, KinematicsError};
 use a2ml_core::math::{DOF, Jacobian6x7, JointVector, Matrix3, Real, Vector3};
@@ -24,6 +26,31 @@ use crate::robot::PyRobot;
 /// Values per row of each batched array.
 const FRAME: usize = kinematics::FRAME_VALUES;
 const JACOBIAN: usize = kinematics::JACOBIAN_VALUES;
+
+/// Rows from which a batch is split over two threads: at about 0.1 µs a row, 256 rows are
+/// some 25 µs of work, well over the few microseconds a hand-over to another thread costs.
+const PARALLEL_ROWS: usize = 256;
+
+/// `run(first_row, rows of q, rows of out)` over all of `q` and `out` (`per_row` values an
+/// output row), as two halves at once when there are [`PARALLEL_ROWS`] rows or more (the cut
+/// on a multiple of the kernel's lanes); each half's answer, the first half's first.
+fn in_halves<R: Send>(
+    q: &[Real],
+    q_per_row: usize,
+    out: &mut [Real],
+    per_row: usize,
+    run: impl Fn(usize, &[Real], &mut [Real]) -> R + Sync,
+) -> [Option<R>; 2] {
+    let rows = (q.len() / q_per_row.max(1)).min(out.len() / per_row.max(1));
+    if rows < PARALLEL_ROWS {
+        return [Some(run(0, q, out)), None];
+    }
+    let half = (rows / 2).next_multiple_of(kinematics::LANES);
+    let (q_a, q_b) = q.split_at(half * q_per_row);
+    let (out_a, out_b) = out.split_at_mut(half * per_row);
+    let (a, b) = rayon::join(|| run(0, q_a, out_a), || run(half, q_b, out_b));
+    [Some(a), Some(b)]
+}
 
 /// A float64 n-dimensional numpy array.
 pub(crate) type Array<'py> = Bound<'py, PyArrayDyn<Real>>;
@@ -224,14 +251,17 @@ impl PyRobot {
         q: &Bound<'py, PyAny>,
         out: Option<&Bound<'py, PyAny>>,
         row: &[usize],
-        kernel: impl FnOnce(&BatchedChain, &[Real], &mut [Real]) + Send,
+        kernel: impl Fn(&BatchedChain, &[Real], &mut [Real]) + Sync,
     ) -> PyResult<Array<'py>> {
         let rows = read_rows(q, "q", &[DOF])?;
         let shape: Vec<usize> = std::iter::once(rows.count).chain(row.iter().copied()).collect();
         let result = output(py, out, "out", &shape)?;
         let mut guard = writer(&result, "out")?;
         let (values, slots) = (rows.values(), slots(&mut guard));
-        py.detach(|| kernel(&self.chain, values, slots));
+        let per_row = row.iter().product();
+        py.detach(|| {
+            in_halves(values, DOF, slots, per_row, |_, q, out| kernel(&self.chain, q, out))
+        });
         drop(guard);
         Ok(result)
     }
@@ -299,28 +329,44 @@ impl PyRobot {
         let values = rows.values();
         let (pw_out, ow_out, swivel_out) =
             (slots(&mut pw_guard), slots(&mut ow_guard), slots(&mut swivel_guard));
-        let failed = py.detach(|| {
-            let mut failed = None;
-            self.chain.cpsa_states(&self.robot, values, |i, state| match state {
-                Ok(s) if failed.is_none() => {
-                    pw_out[3 * i..3 * i + 3].copy_from_slice(s.pw.as_slice());
-                    let r = s.ow.matrix();
-                    for a in 0..3 {
-                        for b in 0..3 {
-                            ow_out[9 * i + 3 * a + b] = r[(a, b)];
+        // One output row: pw (3), ow (9) and the swivel angle, split into the three arrays
+        // below; the first failing row is reported.
+        const ROW: usize = 13;
+        let mut states = vec![0.0; n * ROW];
+        let halves = py.detach(|| {
+            in_halves(values, DOF, &mut states, ROW, |first, q, out| {
+                let mut failed = None;
+                self.chain.cpsa_states(&self.robot, q, |i, state| match state {
+                    Ok(s) if failed.is_none() => {
+                        let out = &mut out[ROW * i..ROW * i + ROW];
+                        out[..3].copy_from_slice(s.pw.as_slice());
+                        let r = s.ow.matrix();
+                        for a in 0..3 {
+                            for b in 0..3 {
+                                out[3 + 3 * a + b] = r[(a, b)];
+                            }
                         }
+                        out[12] = s.swivel;
                     }
-                    swivel_out[i] = s.swivel;
-                }
-                Ok(_) => {}
-                Err(e) => {
-                    failed.get_or_insert((i, e));
-                }
-            });
-            failed
+                    Ok(_) => {}
+                    Err(e) => {
+                        failed.get_or_insert((first + i, e));
+                    }
+                });
+                failed
+            })
         });
-        if let Some((row, e)) = failed {
+        if let Some((row, e)) = halves.into_iter().flatten().flatten().next() {
             return Err(row_error(py, row, e));
+        }
+        for ((state, pw), (ow, swivel)) in states
+            .chunks_exact(ROW)
+            .zip(pw_out.chunks_exact_mut(3))
+            .zip(ow_out.chunks_exact_mut(9).zip(swivel_out.iter_mut()))
+        {
+            pw.copy_from_slice(&state[..3]);
+            ow.copy_from_slice(&state[3..12]);
+            *swivel = state[12];
         }
         drop((pw_guard, ow_guard, swivel_guard));
         Ok((pw, ow, swivel))
@@ -385,36 +431,39 @@ impl PyRobot {
         let out = slots(&mut guard);
         let (pw, swivel) = (pw.values(), swivel.values());
         let near_values = near_rows.as_ref().map(|r| r.values());
-        let failed = py.detach(|| {
-            for (i, q) in out.chunks_exact_mut(DOF).enumerate() {
-                let target = CpsaState {
-                    pw: Vector3::from_column_slice(&pw[3 * i..3 * i + 3]),
-                    ow: rotations[i],
-                    swivel: swivel[i],
-                };
-                let near = near_values
-                    .map(|v| JointVector::from_column_slice(&v[DOF * i..DOF * i + DOF]))
-                    .or(near_one);
-                // The nearest solution alone: ik_cpsa's first, without the others. Without a
-                // q_near, ik_cpsa itself: a numerical arm then tries its guesses first.
-                let solved = match near {
-                    Some(near) => kinematics::ik_cpsa_nearest(&self.robot, &target, &near),
-                    None => kinematics::ik_cpsa(&self.robot, &target, None).and_then(|s| {
-                        s.into_iter().next().ok_or(KinematicsError::NoConvergence {
-                            residual: Real::INFINITY,
-                            starts: 0,
-                        })
-                    }),
-                };
-                match solved {
-                    Ok(solution) => q.copy_from_slice(solution.as_slice()),
-                    Err(e) if on_error == OnError::Raise => return Some((i, e)),
-                    Err(_) => q.fill(Real::NAN),
+        // The first failing row of each half; the first half's first.
+        let halves = py.detach(|| {
+            in_halves(pw, 3, out, DOF, |first, _, out| {
+                for (q, i) in out.chunks_exact_mut(DOF).zip(first..) {
+                    let target = CpsaState {
+                        pw: Vector3::from_column_slice(&pw[3 * i..3 * i + 3]),
+                        ow: rotations[i],
+                        swivel: swivel[i],
+                    };
+                    let near = near_values
+                        .map(|v| JointVector::from_column_slice(&v[DOF * i..DOF * i + DOF]))
+                        .or(near_one);
+                    // The nearest solution alone: ik_cpsa's first, without the others. Without
+                    // a q_near, ik_cpsa itself: a numerical arm then tries its guesses first.
+                    let solved = match near {
+                        Some(near) => kinematics::ik_cpsa_nearest(&self.robot, &target, &near),
+                        None => kinematics::ik_cpsa(&self.robot, &target, None).and_then(|s| {
+                            s.into_iter().next().ok_or(KinematicsError::NoConvergence {
+                                residual: Real::INFINITY,
+                                starts: 0,
+                            })
+                        }),
+                    };
+                    match solved {
+                        Ok(solution) => q.copy_from_slice(solution.as_slice()),
+                        Err(e) if on_error == OnError::Raise => return Some((i, e)),
+                        Err(_) => q.fill(Real::NAN),
+                    }
                 }
-            }
-            None
+                None
+            })
         });
-        if let Some((row, e)) = failed {
+        if let Some((row, e)) = halves.into_iter().flatten().flatten().next() {
             return Err(row_error(py, row, e));
         }
         drop(guard);
