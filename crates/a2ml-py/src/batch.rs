@@ -33,7 +33,8 @@ const PARALLEL_ROWS: usize = 256;
 
 /// `run(first_row, rows of q, rows of out)` over all of `q` and `out` (`per_row` values an
 /// output row), as two halves at once when there are [`PARALLEL_ROWS`] rows or more (the cut
-/// on a multiple of the kernel's lanes); each half's answer, the first half's first.
+/// on a multiple of the kernel's lanes); each half's answer, the first half's first (the
+/// second is always there when the batch was split: the scope waits for it).
 fn in_halves<R: Send>(
     q: &[Real],
     q_per_row: usize,
@@ -48,8 +49,14 @@ fn in_halves<R: Send>(
     let half = (rows / 2).next_multiple_of(kinematics::LANES);
     let (q_a, q_b) = q.split_at(half * q_per_row);
     let (out_a, out_b) = out.split_at_mut(half * per_row);
-    let (a, b) = rayon::join(|| run(0, q_a, out_a), || run(half, q_b, out_b));
-    [Some(a), Some(b)]
+    // The calling thread runs the first half itself (rayon::join from outside the pool would
+    // hand both halves over and wait), a thread of the pool the second.
+    let mut second = None;
+    let first = rayon::in_place_scope(|scope| {
+        scope.spawn(|_| second = Some(run(half, q_b, out_b)));
+        run(0, q_a, out_a)
+    });
+    [Some(first), second]
 }
 
 /// A float64 n-dimensional numpy array.
