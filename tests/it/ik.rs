@@ -5,6 +5,7 @@ use crate::common::{all_robots, regular_q, rng};
 use a2ml::Robot;
 use a2ml::kinematics::*;
 use a2ml::math::{JointVector, Real, rotation_distance, wrap_angle};
+use rand::RngExt;
 
 const SAMPLES: usize = 10_000;
 
@@ -117,6 +118,38 @@ fn nearest_only_ik_equals_the_first_solution() {
     }
 }
 
+/// The same along tracked edges, where the nearest solver prunes shoulder and wrist solutions
+/// by their middle joints: `near` a step of up to 0.3 rad away, and configurations whose
+/// joint 2 or 6 is within a few milliradians of zero (the two solutions of that group then
+/// lie close together, their middle angles of either sign).
+#[test]
+fn nearest_only_ik_equals_the_first_solution_when_tracking() {
+    for (name, robot) in all_robots() {
+        if !robot.has_analytic_ik() {
+            continue;
+        }
+        let mut rng = rng(15);
+        for k in 0..3000 {
+            let mut q = crate::common::random_q(&robot, &mut rng);
+            match k % 4 {
+                1 => q[1] = rng.random_range(-3e-3..3e-3),
+                2 => q[5] = rng.random_range(-3e-3..3e-3),
+                3 => (q[1], q[5]) = (rng.random_range(-1e-6..1e-6), rng.random_range(-1e-6..1e-6)),
+                _ => {}
+            }
+            let pose = a2ml::kinematics::arm_pose(&robot, &q);
+            let Ok(cpsa) = cpsa_state(&robot, &pose) else { continue };
+            let size = [1e-4, 0.03, 0.3][k % 3];
+            let near = q.map(|v| v + rng.random_range(-size..size));
+            let full = ik_cpsa(&robot, &cpsa, Some(&near)).map(|s| s[0]);
+            assert_eq!(ik_cpsa_nearest(&robot, &cpsa, &near), full, "{name}: CPSA at {q:?}");
+            let Ok(hat) = hat_state(&pose) else { continue };
+            let full = ik_hat(&robot, &hat, Some(&near)).map(|s| s[0]);
+            assert_eq!(ik_hat_nearest(&robot, &hat, &near), full, "{name}: HAT at {q:?}");
+        }
+    }
+}
+
 #[test]
 fn mapping_round_trips() {
     for (name, robot) in all_robots() {
@@ -162,7 +195,6 @@ fn mapping_agrees_with_the_arm_on_analytic_arms() {
 /// on analytic arms, the rate whose branches include q.
 fn third_party_round_trips(samples: usize) -> Vec<(&'static str, &'static str, Real, Real)> {
     use a2ml::math::DOF;
-    use rand::RngExt;
     let mut out = Vec::new();
     for (name, robot) in crate::robots::third_party() {
         let mut rng = rng(21);

@@ -273,37 +273,85 @@ pub(crate) fn decompose(
     wc: &Vector3,
     near_a: Real,
 ) -> Result<Solutions, KinematicsError> {
-    // Subproblem 2 on wc: Rot(wb, b) wc = Rot(wa, -a) (R wc) = c.
-    let (v, w) = (*wc, r * wc);
-    let k = wa.dot(wb);
-    let cross = wa.cross(wb);
-    if cross.norm() < 1e-9 {
-        return Err(KinematicsError::Singular(Singularity::ParallelAxes));
-    }
-    let alpha = (wa.dot(&w) - k * wb.dot(&v)) / (1.0 - k * k);
-    let beta = (wb.dot(&v) - k * wa.dot(&w)) / (1.0 - k * k);
-    let gamma_sq = (v.norm_squared() - alpha * alpha - beta * beta - 2.0 * alpha * beta * k)
-        / cross.norm_squared();
+    let split = Split::new(r, wa, wb, wc, near_a)?;
     let mut out = Solutions::NONE;
-    if gamma_sq < -1e-9 {
-        // The rotation is outside what these three axes can produce.
-        return Ok(out);
-    }
-    let gamma = gamma_sq.max(0.0).sqrt();
-    let gammas: &[Real] = if gamma < 1e-12 { &[0.0] } else { &[gamma, -gamma] };
-    // Any direction orthogonal to wc shows the last angle.
-    let probe = wc.cross(&if wc.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() });
-    let r_probe = r * probe;
-    for &g in gammas {
-        let c = alpha * wa + beta * wb + g * cross;
-        let b = rotation_turn(wb, &v, &c).unwrap_or_else(|| Turn::of(0.0));
-        let a = rotation_turn(wa, &c, &w).unwrap_or_else(|| Turn::of(near_a));
-        // Rot(wc, c) probe = Rot(wb, -b) Rot(wa, -a) R probe.
-        let turned = b.apply(wb, &a.apply(wa, &r_probe, true), true);
-        let c_angle = rotation_turn(wc, &probe, &turned).map_or(0.0, |t| t.angle);
-        out.push([a.angle, b.angle, c_angle]);
+    for i in 0..split.len {
+        out.push(split.solution(i));
     }
     Ok(out)
+}
+
+/// A three-axis decomposition in two stages: each solution's middle angle first (which
+/// bounds its distance from a configuration), its outer angles when asked. The same
+/// arithmetic as [`decompose`], which runs both stages.
+struct Split<'a> {
+    wa: &'a Vector3,
+    wb: &'a Vector3,
+    wc: &'a Vector3,
+    /// R wc.
+    w: Vector3,
+    /// A direction orthogonal to wc, and R times it.
+    probe: Vector3,
+    r_probe: Vector3,
+    near_a: Real,
+    /// Per solution, Rot(wb, b) wc and the middle turn b.
+    middles: [(Vector3, Turn); 2],
+    len: usize,
+}
+
+impl<'a> Split<'a> {
+    fn new(
+        r: &Matrix3,
+        wa: &'a Vector3,
+        wb: &'a Vector3,
+        wc: &'a Vector3,
+        near_a: Real,
+    ) -> Result<Self, KinematicsError> {
+        // Subproblem 2 on wc: Rot(wb, b) wc = Rot(wa, -a) (R wc) = c.
+        let (v, w) = (*wc, r * wc);
+        let k = wa.dot(wb);
+        let cross = wa.cross(wb);
+        if cross.norm() < 1e-9 {
+            return Err(KinematicsError::Singular(Singularity::ParallelAxes));
+        }
+        // Any direction orthogonal to wc shows the last angle.
+        let probe = wc.cross(&if wc.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() });
+        let zero = (Vector3::zeros(), Turn::of(0.0));
+        let mut split =
+            Self { wa, wb, wc, w, probe, r_probe: r * probe, near_a, middles: [zero; 2], len: 0 };
+        let alpha = (wa.dot(&w) - k * wb.dot(&v)) / (1.0 - k * k);
+        let beta = (wb.dot(&v) - k * wa.dot(&w)) / (1.0 - k * k);
+        let gamma_sq = (v.norm_squared() - alpha * alpha - beta * beta - 2.0 * alpha * beta * k)
+            / cross.norm_squared();
+        if gamma_sq < -1e-9 {
+            // The rotation is outside what these three axes can produce.
+            return Ok(split);
+        }
+        let gamma = gamma_sq.max(0.0).sqrt();
+        let gammas: &[Real] = if gamma < 1e-12 { &[0.0] } else { &[gamma, -gamma] };
+        for &g in gammas {
+            let c = alpha * wa + beta * wb + g * cross;
+            let b = rotation_turn(wb, &v, &c).unwrap_or_else(|| Turn::of(0.0));
+            split.middles[split.len] = (c, b);
+            split.len += 1;
+        }
+        Ok(split)
+    }
+
+    /// The middle angle of solution `i`.
+    fn middle(&self, i: usize) -> Real {
+        self.middles[i].1.angle
+    }
+
+    /// Solution `i`: (a, b, c).
+    fn solution(&self, i: usize) -> [Real; 3] {
+        let (c, b) = &self.middles[i];
+        let a = rotation_turn(self.wa, c, &self.w).unwrap_or_else(|| Turn::of(self.near_a));
+        // Rot(wc, c) probe = Rot(wb, -b) Rot(wa, -a) R probe.
+        let turned = b.apply(self.wb, &a.apply(self.wa, &self.r_probe, true), true);
+        let c_angle = rotation_turn(self.wc, &self.probe, &turned).map_or(0.0, |t| t.angle);
+        [a.angle, b.angle, c_angle]
+    }
 }
 
 /// The rotation taking the pair (a0, b0) onto (a1, b1), which must have the
@@ -503,8 +551,16 @@ fn nearest_branch(
         }
     }
     let tolerance = IkOptions::default().limit_tolerance;
-    // (distance, elbow angle's index as `select` meets it, index within it, joints)
-    let mut best: Option<(Real, usize, usize, JointVector)> = None;
+    let w = &s.axes_zero;
+    // A branch's distance from `near` is at least that of its joints 2, 4 and 6 alone, 2π
+    // shifts included: the middle angles come before the outer ones, so a shoulder or wrist
+    // solution that cannot be nearest is never finished. The margin keeps every skipped
+    // branch, and any near-copy of one that the deduplication below would have dropped,
+    // farther than the nearest.
+    let apart = |angle: Real, j: usize| (wrap_angle(angle - near[j]).abs() - 2e-9).max(0.0);
+    // (distance, elbow angle's index as `select` meets it, (shoulder, wrist, shift) within
+    // it, which orders as the branch's index there, joints)
+    let mut best: Option<(Real, usize, (usize, usize, usize), JointVector)> = None;
     let mut branches = Vec::with_capacity(8);
     let mut kept: Vec<JointVector> = Vec::with_capacity(8);
     for g in order {
@@ -512,22 +568,65 @@ fn nearest_branch(
         if best.is_some_and(|(d, ..)| bound(q4) > d) {
             continue;
         }
-        branches.clear();
+        // Whatever the shoulder branch, R1 R2 R3 = r123: the wrist's share of Ow is the same
+        // for both, so it is split once per q4 (as in `elbow_branches`).
+        let r567 = (r123 * rotation_about(&w[3], q4)).transpose()
+            * ow.matrix()
+            * s.hand_zero.matrix().transpose();
+        let wrists = Split::new(&r567, &w[4], &w[5], &w[6], near[4])?;
+        let shoulders = Split::new(&r123, &w[0], &w[1], &w[2], near[0])?;
+        let mut shoulder_done: [Option<[Real; 3]>; 2] = [None; 2];
+        let mut wrist_done: [Option<[Real; 3]>; 2] = [None; 2];
+        let joints = |sh: [Real; 3], wr: [Real; 3]| {
+            JointVector::from_column_slice(&[sh[0], sh[1], sh[2], q4, wr[0], wr[1], wr[2]])
+        };
+        let lower = |i: usize, j: usize| {
+            let (a, b, c) =
+                (apart(shoulders.middle(i), 1), apart(q4, 3), apart(wrists.middle(j), 5));
+            (a * a + b * b + c * c).sqrt()
+        };
+        // An upper bound on the nearest distance: the in-limit versions of the pair whose
+        // lower bound is least (it or a near-copy of it is among the branches below).
+        let mut limit = best.map_or(Real::INFINITY, |(d, ..)| d + 1e-8);
+        let pairs = (0..shoulders.len).flat_map(|i| (0..wrists.len).map(move |j| (i, j)));
+        if let Some((i, j)) =
+            pairs.clone().min_by(|a, b| lower(a.0, a.1).total_cmp(&lower(b.0, b.1)))
+        {
+            let (sh, wr) = (shoulders.solution(i), wrists.solution(j));
+            shoulder_done[i] = Some(sh);
+            wrist_done[j] = Some(wr);
+            branches.clear();
+            push_shifts(robot, joints(sh, wr), &mut branches);
+            for q in branches.iter().filter(|q| robot.within_limits(q, tolerance)) {
+                limit = limit.min((q - near).norm() + 1e-8);
+            }
+        }
         kept.clear();
-        elbow_branches(robot, s, q4, &r123, ow, near, &mut branches)?;
-        for (k, q) in branches.iter().enumerate() {
-            if !robot.within_limits(q, tolerance) || kept.iter().any(|p| (p - q).amax() < 1e-9) {
+        for (i, j) in pairs {
+            if lower(i, j) > limit {
                 continue;
             }
-            kept.push(*q);
-            let d = (q - near).norm();
-            let better = match best {
-                None => true,
-                // A stable sort by distance keeps the earlier of equal ones.
-                Some((bd, bg, bk, _)) => d < bd || (d == bd && (g, k) < (bg, bk)),
-            };
-            if better {
-                best = Some((d, g, k, *q));
+            let sh = *shoulder_done[i].get_or_insert_with(|| shoulders.solution(i));
+            let wr = *wrist_done[j].get_or_insert_with(|| wrists.solution(j));
+            branches.clear();
+            push_shifts(robot, joints(sh, wr), &mut branches);
+            for (k, q) in branches.iter().enumerate() {
+                if !robot.within_limits(q, tolerance) || kept.iter().any(|p| (p - q).amax() < 1e-9)
+                {
+                    continue;
+                }
+                kept.push(*q);
+                let d = (q - near).norm();
+                let at = (i, j, k);
+                let better = match best {
+                    None => true,
+                    // A stable sort by distance keeps the earlier of equal ones.
+                    Some((bd, bg, bat, _)) => d < bd || (d == bd && (g, at) < (bg, bat)),
+                };
+                if better {
+                    best = Some((d, g, at, *q));
+                    limit = limit.min(d + 1e-8);
+                }
             }
         }
     }

@@ -217,10 +217,18 @@ impl<'a> Search<'a> {
         let mut step: Real = 1.0;
         while tau < 1.0 {
             let mut trial = step.min(1.0 - tau);
+            // The last middle point solved (edge fraction, joints): a step halved lands on it,
+            // and the same point from the same joints has the same solution.
+            let mut solved: Option<(Real, JointVector)> = None;
             let next = loop {
                 let last = trial >= 1.0 - tau;
-                let x = if last { *b } else { self.chart.interpolate(a, b, tau + trial) };
-                let candidate = self.chart.ik_near(self.robot, &x, &q)?;
+                let candidate = match solved {
+                    Some((at, q_at)) if !last && at == tau + trial => q_at,
+                    _ => {
+                        let x = if last { *b } else { self.chart.interpolate(a, b, tau + trial) };
+                        self.chart.ik_near(self.robot, &x, &q)?
+                    }
+                };
                 let delta = candidate - q;
                 let jump = delta.amax();
                 // Interpolation is uniform in chart length, so this step is trial × length
@@ -233,8 +241,11 @@ impl<'a> Search<'a> {
                 } else {
                     // The IK curve leaves the chord by about its deviation at the middle
                     // (exactly, were it quadratic): the chord must keep that much more.
-                    let middle = self.chart.interpolate(a, b, tau + 0.5 * trial.min(1.0 - tau));
-                    let bend = self.chart.ik_near(self.robot, &middle, &q)? - (q + candidate) * 0.5;
+                    let at = tau + 0.5 * trial.min(1.0 - tau);
+                    let q_middle =
+                        self.chart.ik_near(self.robot, &self.chart.interpolate(a, b, at), &q)?;
+                    solved = Some((at, q_middle));
+                    let bend = q_middle - (q + candidate) * 0.5;
                     let needed = self.kept + 2.0 * motion_bound(&self.model, &bend);
                     self.checks += 1;
                     let reach = if jump == 0.0 {
@@ -290,28 +301,53 @@ impl<'a> Search<'a> {
         samples: usize,
         nodes: usize,
     ) -> ConstrainedPath {
+        // A pair whose attempt failed, or left the path as it was, is not tracked again until
+        // the path changes: tracking is deterministic, so the answer would be the same. The
+        // random draws stop once every pair is settled (nothing draws after them).
+        let mut settled: Vec<(usize, usize)> = Vec::new();
+        // Per edge of `path`, the forward track a shortcut made of it (checked points, arrival,
+        // its clearance): the same as tracking it again below.
+        let mut recorded: Vec<Option<Track>> = vec![None; path.len().saturating_sub(1)];
         for _ in 0..self.options.shortcuts {
-            if path.len() < 3 {
+            let n = path.len();
+            if n < 3 || settled.len() == (n - 1) * (n - 2) / 2 {
                 break;
             }
-            let i = rng.random_range(0..path.len() - 2);
-            let j = rng.random_range(i + 2..path.len());
+            let i = rng.random_range(0..n - 2);
+            let j = rng.random_range(i + 2..n);
+            if settled.contains(&(i, j)) {
+                continue;
+            }
             let ((xi, qi), (xj, qj)) = (path[i], path[j]);
-            if let Some((q, d)) = self.track(&xi, &qi, &xj) {
-                if self.meets_at(&q, d, &qj) {
-                    // The arrival stays, for the self-motion onto qj if there is one.
+            let mut track = Vec::new();
+            let arrival = self
+                .track_recorded(&xi, &qi, &xj, &mut track)
+                .filter(|(q, d)| self.meets_at(q, *d, &qj));
+            match arrival {
+                // The arrival stays, for the self-motion onto qj if there is one.
+                Some((q, d)) if !(j == i + 2 && path[i + 1] == (xj, q)) => {
                     path.splice(i + 1..j, [(xj, q)]);
+                    recorded.splice(i..j, [Some((track, q, d)), None]);
+                    settled.clear();
                 }
+                _ => settled.push((i, j)),
             }
         }
         // The IK solutions along each edge, as checked: timing follows them, so that it
         // stays on the branch the checks saw. An edge of the goal tree was grown from its
         // far end; it is tracked that way again when it does not track forwards.
         let mut tracks = Vec::with_capacity(path.len().saturating_sub(1));
-        for w in path.windows(2) {
+        for (w, known) in path.windows(2).zip(recorded) {
             let ((a, qa), (b, qb)) = (w[0], w[1]);
-            let mut track = Vec::new();
-            match self.track_recorded(&a, &qa, &b, &mut track) {
+            let (mut track, forward) = match known {
+                Some((track, q, d)) => (track, Some((q, d))),
+                None => {
+                    let mut track = Vec::new();
+                    let forward = self.track_recorded(&a, &qa, &b, &mut track);
+                    (track, forward)
+                }
+            };
+            match forward {
                 Some((q, d)) if self.meets_at(&q, d, &qb) => {}
                 _ => {
                     track.clear();
@@ -336,6 +372,10 @@ impl<'a> Search<'a> {
         ConstrainedPath { waypoints, configurations, tracks, stats }
     }
 }
+
+/// An edge's forward track: its checked points (edge fraction, joints), the arrival and the
+/// arrival's clearance.
+type Track = (Vec<(Real, JointVector)>, JointVector, Real);
 
 /// A node of a chart tree: its chart point, the IK solution tracked there and its clearance.
 #[derive(Debug, Clone, Copy)]
