@@ -57,7 +57,12 @@ def euler_xyz(q: list[float]) -> list[float]:
     return [roll, pitch, yaw]
 
 
-def vamp_environment(problem: dict):
+def vamp_environment(problem: dict, scene: str):
+    """VAMP's environment as its own `vamp.problem_dict_to_vamp` builds it for its MBM
+    evaluation: a cylinder becomes a capsule (VAMP has no cylinder primitive), except in the
+    box scene, where it becomes its bounding box (VAMP's comment: the top-down grasp of that
+    scene's cylinder would not fit a capsule's rounded ends). Both over-approximate the
+    cylinder that a2ml checks exactly, which is why paths are cross-checked."""
     env = vamp.Environment()
     for o in problem["obstacles"]:
         euler = euler_xyz(o["orientation_quat_xyzw"])
@@ -65,8 +70,11 @@ def vamp_environment(problem: dict):
             env.add_sphere(vamp.Sphere(o["position"], o["radius"]))
         elif o["type"] == "box":
             env.add_cuboid(vamp.Cuboid(o["position"], euler, o["half_extents"]))
+        elif scene == "box":
+            env.add_cuboid(vamp.Cuboid(o["position"], euler,
+                                       [o["radius"], o["radius"], o["length"] / 2]))
         else:
-            env.add_cylinder(vamp.Cylinder(o["position"], euler, o["radius"], o["length"]))
+            env.add_capsule(vamp.Cylinder(o["position"], euler, o["radius"], o["length"]))
     return env
 
 
@@ -78,18 +86,19 @@ class Vamp:
          self.simplify_settings) = vamp.configure_robot_and_planner_with_kwargs("panda", "rrtc")
         self.resolution = self.module.resolution()
 
-    def prepare(self, problem):
-        return vamp_environment(problem)
+    def prepare(self, problem, scene):
+        return vamp_environment(problem, scene)
 
     def plan(self, problem, env):
         sampler = self.module.halton()
         start = time.perf_counter()
-        result = self.planner(problem["start"], problem["goals"][0], env, self.settings, sampler)
+        result = self.planner(problem["start"], problem["goals"], env, self.settings, sampler)
         if not result.solved:
             return time.perf_counter() - start, None
         path = self.module.simplify(result.path, env, self.simplify_settings, sampler).path
         elapsed = time.perf_counter() - start
-        return elapsed, np.array([list(c.to_list()) for c in path])
+        # `Path.numpy()`: (waypoints, 7). Iterating a Path by index does not stop at its end.
+        return elapsed, np.asarray(path.numpy(), dtype=float)
 
     def valid_path(self, problem, env, waypoints) -> bool:
         """Every configuration at VAMP's resolution along every edge passes `validate`."""
@@ -106,7 +115,7 @@ class A2ml:
         self.name = f"a2ml/{model}"
         self.robot = a2ml.Robot.from_urdf(MODELS[model])
 
-    def prepare(self, problem):
+    def prepare(self, problem, scene):
         return problem["obstacles"]
 
     def plan(self, problem, obstacles):
@@ -132,7 +141,7 @@ def run_scene(name, planners, count, rounds):
     problems = problems["problems"][:count]
     times = {p.name: [[] for _ in problems] for p in planners}
     paths = {p.name: [None] * len(problems) for p in planners}
-    prepared = [[p.prepare(problem) for p in planners] for problem in problems]
+    prepared = [[p.prepare(problem, name) for p in planners] for problem in problems]
     for r in range(rounds):
         for i, problem in enumerate(problems):
             order = list(range(len(planners)))
