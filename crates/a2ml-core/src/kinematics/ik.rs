@@ -560,7 +560,8 @@ fn nearest_branch(
     let apart = |angle: Real, j: usize| (wrap_angle(angle - near[j]).abs() - 2e-9).max(0.0);
     // (distance, elbow angle's index as `select` meets it, (shoulder, wrist, shift) within
     // it, which orders as the branch's index there, joints)
-    let mut best: Option<(Real, usize, (usize, usize, usize), JointVector)> = None;
+    type Candidate = (Real, usize, (usize, usize, usize), JointVector);
+    let mut best: Option<Candidate> = None;
     let mut branches = Vec::with_capacity(8);
     let mut kept: Vec<JointVector> = Vec::with_capacity(8);
     for g in order {
