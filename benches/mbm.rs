@@ -11,7 +11,7 @@ use std::time::Instant;
 use a2ml::Robot;
 use a2ml::collision::CollisionScene;
 use a2ml::math::Real;
-use a2ml::solve::rrt::{RrtOptions, RrtStats, rrt_connect};
+use a2ml::solve::rrt::{RrtError, RrtOptions, RrtStats, rrt_connect};
 use criterion::{Criterion, criterion_group, criterion_main};
 
 #[path = "../tests/it/mbm_problems.rs"]
@@ -27,19 +27,32 @@ fn median(mut values: Vec<Real>) -> Real {
     values.get(values.len() / 2).copied().unwrap_or(Real::NAN)
 }
 
+/// Why the unsolved problems of a scene were not solved: an end refused (outside the limits or
+/// within the clearance), or the sample budget used.
+#[derive(Default)]
+struct Refused {
+    start: usize,
+    goals: usize,
+    budget: usize,
+}
+
 /// One line of the table: solve rate, median time, and the median counters of a solved problem.
-fn report(model: &str, name: &str, total: usize, solved: &[(Real, RrtStats)]) {
+fn report(model: &str, name: &str, total: usize, solved: &[(Real, RrtStats)], refused: &Refused) {
     let of = |f: fn(&(Real, RrtStats)) -> Real| median(solved.iter().map(f).collect());
     let per_check = of(|(t, s)| t / s.collision_checks.max(1) as Real);
     println!(
         "mbm/{model}/{name}: {} of {total} solved, median {:.3} ms; per solved problem (medians) \
-         {} samples, {} nodes, {} collision queries, {:.2} µs per query",
+         {} samples, {} nodes, {} collision queries, {:.2} µs per query; unsolved: {} starts \
+         invalid, {} with no valid goal, {} out of samples",
         solved.len(),
         of(|(t, _)| *t) * 1e3,
         of(|(_, s)| s.samples as Real),
         of(|(_, s)| s.nodes as Real),
         of(|(_, s)| s.collision_checks as Real),
         per_check * 1e6,
+        refused.start,
+        refused.goals,
+        refused.budget,
     );
 }
 
@@ -56,14 +69,21 @@ fn mbm(c: &mut Criterion) {
                 .collect();
             let mut solved = Vec::new();
             let mut solvable = Vec::new();
+            let mut refused = Refused::default();
             for (scene, p) in &problems {
                 let started = Instant::now();
-                if let Ok(path) = rrt_connect(&robot, scene, &p.start, &p.goals, &options) {
-                    solved.push((started.elapsed().as_secs_f64(), path.stats));
-                    solvable.push((scene, p));
+                match rrt_connect(&robot, scene, &p.start, &p.goals, &options) {
+                    Ok(path) => {
+                        solved.push((started.elapsed().as_secs_f64(), path.stats));
+                        solvable.push((scene, p));
+                    }
+                    Err(RrtError::InvalidStart { .. }) => refused.start += 1,
+                    Err(RrtError::NoValidGoal { .. }) => refused.goals += 1,
+                    Err(RrtError::NoPath { .. }) => refused.budget += 1,
+                    Err(e) => panic!("{model}/{name}: {e}"),
                 }
             }
-            report(model, name, problems.len(), &solved);
+            report(model, name, problems.len(), &solved, &refused);
             solvable.truncate(10);
             group.bench_function(format!("{model}/{name}_10_problems"), |b| {
                 b.iter(|| {

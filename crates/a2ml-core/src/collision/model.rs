@@ -94,9 +94,12 @@ impl Convex {
                 d.sup(&Vector3::zeros()).norm() + d.max().min(0.0)
             }
             Solid::Cylinder { radius, half_height } => {
-                let radial = local.x.hypot(local.y) - radius;
+                // Square roots rather than hypot (several times slower): nothing here is near
+                // overflow or underflow.
+                let radial = (local.x * local.x + local.y * local.y).sqrt() - radius;
                 let axial = local.z.abs() - half_height;
-                radial.max(0.0).hypot(axial.max(0.0)) + radial.max(axial).min(0.0)
+                let (r, z) = (radial.max(0.0), axial.max(0.0));
+                (r * r + z * z).sqrt() + radial.max(axial).min(0.0)
             }
         }
     }
@@ -120,7 +123,7 @@ impl Convex {
                 }
             }
             Solid::Cylinder { radius, half_height } => {
-                let length = local.x.hypot(local.y);
+                let length = (local.x * local.x + local.y * local.y).sqrt();
                 // On the axis any horizontal unit vector is a subgradient of the radial part.
                 let out = if length > 0.0 {
                     Vector3::new(local.x / length, local.y / length, 0.0)
@@ -130,7 +133,7 @@ impl Convex {
                 let up = Vector3::new(0.0, 0.0, sign.z);
                 let (radial, axial) = (length - radius, local.z.abs() - half_height);
                 if radial > 0.0 && axial > 0.0 {
-                    let d = radial.hypot(axial);
+                    let d = (radial * radial + axial * axial).sqrt();
                     (d, (out * radial + up * axial) / d)
                 } else if radial >= axial {
                     (radial, out)
@@ -225,6 +228,9 @@ struct LinkCapsule {
     a: Vector3,
     b: Vector3,
     radius: Real,
+    /// The midpoint of a–b (aligned frame), and the radius of the bounding sphere about it.
+    center: Vector3,
+    bound: Real,
     /// Per joint, how far any point of the segment can be from the joint's axis (m), over all
     /// configurations: the segment moves at most Σ levers_j |Δq_j| along a straight
     /// joint-space motion Δq.
@@ -243,6 +249,8 @@ struct SelfPair {
     joints: std::ops::Range<usize>,
     /// The distal capsule's levers for those joints, zero for the others.
     levers: JointVector,
+    /// The sum of the two bounding spheres' radii.
+    bounds: Real,
 }
 
 #[derive(Debug, Clone)]
@@ -266,12 +274,20 @@ impl CollisionModel {
         let links: Vec<LinkCapsule> = robot
             .capsules
             .iter()
-            .map(|c| LinkCapsule {
-                frame: c.frame,
-                a: chain.aligned_from_frame[c.frame] * c.a,
-                b: chain.aligned_from_frame[c.frame] * c.b,
-                radius: c.radius,
-                levers: levers(robot, c.frame, &c.a, &c.b),
+            .map(|c| {
+                let (a, b) = (
+                    chain.aligned_from_frame[c.frame] * c.a,
+                    chain.aligned_from_frame[c.frame] * c.b,
+                );
+                LinkCapsule {
+                    frame: c.frame,
+                    a,
+                    b,
+                    radius: c.radius,
+                    center: 0.5 * (a + b),
+                    bound: 0.5 * (b - a).norm() + c.radius,
+                    levers: levers(robot, c.frame, &c.a, &c.b),
+                }
             })
             .collect();
         let mut groups: Vec<Group> = Vec::new();
@@ -318,7 +334,8 @@ impl CollisionModel {
                 let levers = JointVector::from_fn(|j, _| {
                     if joints.contains(&j) { links[distal].levers[j] } else { 0.0 }
                 });
-                SelfPair { link, other, distal, joints, levers }
+                let bounds = links[link].bound + links[other].bound;
+                SelfPair { link, other, distal, joints, levers, bounds }
             })
             .collect();
         let group_of = |capsule: usize| groups.iter().position(|g| g.members.contains(&capsule));
@@ -563,7 +580,9 @@ impl CollisionModel {
                 }
             }
         }
-        // A capsule is in many self pairs: placed once.
+        // A capsule is in many self pairs: its bounding sphere's centre placed once, and the
+        // capsule itself once, only for a pair the bounding spheres do not settle.
+        let mut centers = Centers::new();
         let mut placed = Placed::new();
         let bounding = |group: usize| {
             self.groups.get(group).map(|g| (frames[g.frame].apply(&g.center), g.bound))
@@ -578,18 +597,27 @@ impl CollisionModel {
                 }
             }
             for pair in &self.self_pairs[group_pair.pairs.clone()] {
+                let loose = loose(&pair.levers);
+                // Only bounding spheres closer than this (centre to centre) may lower `best`;
+                // compared squared, so that most pairs cost no square root.
+                let reach = loose.threshold(best) + offset + pair.bounds;
+                if reach.is_nan() || reach <= 0.0 {
+                    continue;
+                }
+                let gap = centers.get(pair.link, &self.links, &frames)
+                    - centers.get(pair.other, &self.links, &frames);
+                if gap.norm_squared() >= reach * reach {
+                    continue;
+                }
                 let link = placed.get(pair.link, &self.links, &frames);
                 let other = placed.get(pair.other, &self.links, &frames);
                 let moved = if pair.distal == pair.link { &link } else { &other };
-                let loose = loose(&pair.levers);
-                if link.gap_bound(&other) - offset < loose.threshold(best) {
-                    let slack = link.distance(&other) - offset;
-                    if loose.reach(slack) < best {
-                        let exact = exact(moved, &pair.levers, pair.joints.clone());
-                        best = best.min(exact.reach(slack));
-                        if best < least {
-                            return best;
-                        }
+                let slack = link.distance(&other) - offset;
+                if loose.reach(slack) < best {
+                    let exact = exact(moved, &pair.levers, pair.joints.clone());
+                    best = best.min(exact.reach(slack));
+                    if best < least {
+                        return best;
                     }
                 }
             }
@@ -616,6 +644,33 @@ impl Placed {
             Some(slot) => *slot.get_or_insert_with(|| links[i].posed(frames)),
             None => links[i].posed(frames),
         }
+    }
+}
+
+/// The centres of the first [`Centers::CAPACITY`] capsules' bounding spheres placed at most
+/// once per query, on the stack; the others (a model of more) placed at each use.
+struct Centers {
+    placed: u64,
+    slots: [Vector3; Self::CAPACITY],
+}
+
+impl Centers {
+    const CAPACITY: usize = 64;
+
+    fn new() -> Self {
+        Self { placed: 0, slots: [Vector3::zeros(); Self::CAPACITY] }
+    }
+
+    fn get(&mut self, i: usize, links: &[LinkCapsule], frames: &[Frame; DOF + 1]) -> Vector3 {
+        let place = || frames[links[i].frame].apply(&links[i].center);
+        if i >= Self::CAPACITY {
+            return place();
+        }
+        if self.placed & (1 << i) == 0 {
+            self.slots[i] = place();
+            self.placed |= 1 << i;
+        }
+        self.slots[i]
     }
 }
 
@@ -764,11 +819,6 @@ impl Posed {
             center: 0.5 * (a + b),
             bound: 0.5 * squared_length.sqrt() + radius,
         }
-    }
-
-    /// A lower bound of the distance to `other` from the bounding spheres.
-    fn gap_bound(&self, other: &Posed) -> Real {
-        (self.center - other.center).norm() - self.bound - other.bound
     }
 
     /// Signed distance to another capsule.
