@@ -113,13 +113,13 @@ impl BatchedChain {
     /// The hand frame {W} (row-major 4x4: Ow and W) at each row of `q`.
     pub fn hand_frames(&self, q: &[Real], frames: &mut [Real]) {
         let rows = frames.chunks_exact_mut(FRAME_VALUES);
-        self.each_group(q, rows, |pose, lane, frame| write_frame(frame, pose, lane));
+        self.each_group::<false, _>(q, rows, |pose, lane, frame| write_frame(frame, pose, lane));
     }
 
     /// J_ge (row-major 6x7, as [`super::geometric_jacobian`]) at each row of `q`.
     pub fn jacobians(&self, q: &[Real], jacobians: &mut [Real]) {
         let rows = jacobians.chunks_exact_mut(JACOBIAN_VALUES);
-        self.each_group(q, rows, |pose, lane, j| write_jacobian(j, pose, lane));
+        self.each_group::<true, _>(q, rows, |pose, lane, j| write_jacobian(j, pose, lane));
     }
 
     /// The hand frame and J_ge at each row of `q`, from one forward kinematics.
@@ -131,7 +131,7 @@ impl BatchedChain {
     ) {
         let rows =
             frames.chunks_exact_mut(FRAME_VALUES).zip(jacobians.chunks_exact_mut(JACOBIAN_VALUES));
-        self.each_group(q, rows, |pose, lane, (frame, j)| {
+        self.each_group::<true, _>(q, rows, |pose, lane, (frame, j)| {
             write_frame(frame, pose, lane);
             write_jacobian(j, pose, lane);
         });
@@ -146,7 +146,7 @@ impl BatchedChain {
         mut states: impl FnMut(usize, Result<CpsaState, KinematicsError>),
     ) {
         let rows = q.len() / DOF;
-        self.each_group(q, 0..rows, |pose, lane, row| {
+        self.each_group::<false, _>(q, 0..rows, |pose, lane, row| {
             let point = |v: &LaneVector| Vector3::new(v[0][lane], v[1][lane], v[2][lane]);
             let hand = Matrix3::from_fn(|i, j| pose.hand[i][j][lane]);
             let hand = Rotation3::from_matrix_unchecked(hand);
@@ -160,8 +160,9 @@ impl BatchedChain {
     /// On x86_64 processors with AVX2 the loop runs as a copy compiled for them (four lanes
     /// to an instruction instead of two); both copies do the same operations in the same
     /// order (Rust never fuses a multiply and an add on its own), so the bits are the same.
+    /// `LINEAR`: whether the pose needs J_ge's linear rows (left zero otherwise).
     #[inline(always)]
-    fn each_group<O>(
+    fn each_group<const LINEAR: bool, O>(
         &self,
         q: &[Real],
         outputs: impl IntoIterator<Item = O>,
@@ -172,27 +173,27 @@ impl BatchedChain {
             // SAFETY: the processor has AVX2, checked on the line above.
             #[allow(unsafe_code)]
             unsafe {
-                return self.each_group_avx2(q, outputs, each);
+                return self.each_group_avx2::<LINEAR, O>(q, outputs, each);
             }
         }
-        self.each_group_portable(q, outputs, each);
+        self.each_group_portable::<LINEAR, O>(q, outputs, each);
     }
 
     /// [`Self::each_group`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn each_group_avx2<O>(
+    fn each_group_avx2<const LINEAR: bool, O>(
         &self,
         q: &[Real],
         outputs: impl IntoIterator<Item = O>,
         each: impl FnMut(&GroupPose, usize, O),
     ) {
-        self.each_group_portable(q, outputs, each);
+        self.each_group_portable::<LINEAR, O>(q, outputs, each);
     }
 
     /// [`Self::each_group`] for any processor; inlined into the AVX2 copy.
     #[inline(always)]
-    fn each_group_portable<O>(
+    fn each_group_portable<const LINEAR: bool, O>(
         &self,
         q: &[Real],
         outputs: impl IntoIterator<Item = O>,
@@ -210,7 +211,7 @@ impl BatchedChain {
                     joints[k][l] = group[DOF * lane + k];
                 }
             }
-            let pose = self.group_pose(&joints);
+            let pose = self.group_pose::<LINEAR>(&joints);
             for lane in 0..rows {
                 let Some(out) = outputs.next() else { return };
                 each(&pose, lane, out);
@@ -218,9 +219,10 @@ impl BatchedChain {
         }
     }
 
-    /// Forward kinematics of one group: `joints[k]` holds joint k's value in each lane.
+    /// Forward kinematics of one group: `joints[k]` holds joint k's value in each lane; J_ge's
+    /// linear rows only when `LINEAR` (the frames and CPSA states do not read them).
     #[inline(always)]
-    fn group_pose(&self, joints: &[Lane; DOF]) -> GroupPose {
+    fn group_pose<const LINEAR: bool>(&self, joints: &[Lane; DOF]) -> GroupPose {
         let mut rotation: LaneMatrix = [[[0.0; LANES]; 3]; 3];
         for (i, row) in rotation.iter_mut().enumerate() {
             row[i] = [1.0; LANES];
@@ -253,7 +255,7 @@ impl BatchedChain {
         // W's velocity per unit rate of each joint: z_k × (W - p_k); joint 7 cannot move W,
         // which rides on frame 6.
         let mut linear = [[[0.0; LANES]; 3]; DOF];
-        for k in 0..DOF - 1 {
+        for k in (0..DOF - 1).filter(|_| LINEAR) {
             let (z, p) = (&axes[k], &axis_points[k]);
             for l in 0..LANES {
                 let d = [wrist[0][l] - p[0][l], wrist[1][l] - p[1][l], wrist[2][l] - p[2][l]];
@@ -544,7 +546,7 @@ mod tests {
             let rows = portable_frames
                 .chunks_exact_mut(FRAME_VALUES)
                 .zip(portable_jacobians.chunks_exact_mut(JACOBIAN_VALUES));
-            chain.each_group_portable(&q, rows, |pose, lane, (frame, j)| {
+            chain.each_group_portable::<true, _>(&q, rows, |pose, lane, (frame, j)| {
                 write_frame(frame, pose, lane);
                 write_jacobian(j, pose, lane);
             });
