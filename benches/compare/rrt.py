@@ -8,6 +8,10 @@ to round; a problem's figure per planner is the median over rounds, and a2ml/VAM
 over problems of the per-problem ratio of medians (paired: the same problems, the same rounds,
 the same load). Solve rates count problems solved in every round.
 
+VAMP counts a configuration free when no sphere overlaps an obstacle (touching is free); a2ml's
+default keeps 1 cm. So a2ml with the spheres runs twice: at its default 0.01 m and at 0 m, the
+latter being VAMP's criterion and the like-for-like ratio.
+
 The models differ, so each path is also checked in the other's: a2ml's paths by VAMP's
 `validate` at VAMP's own resolution along each edge, and VAMP's paths by a2ml's exact clearance
 (`a2ml.scene_clearance`, ≥ 0) at 1 mm of arm motion along each edge.
@@ -16,9 +20,8 @@ The models differ, so each path is also checked in the other's: a2ml's paths by 
 
 Run in .venv-compare (benches/compare/requirements.txt); a peer that does not import is
 reported as missing, never replaced. The VAMP calls follow vamp-planner 0.6.4's Python API
-(configure_robot_and_planner_with_kwargs, halton, simplify, validate); its sdist did not build
-on the machine this was written on (no network for its CMake dependencies), so they have not
-run here yet. OMPL is not wired in.
+(configure_robot_and_planner_with_kwargs, halton, simplify, validate); benches/compare/README.md
+says how it was built offline here. OMPL is not wired in.
 """
 
 from __future__ import annotations
@@ -111,9 +114,10 @@ class Vamp:
 
 
 class A2ml:
-    def __init__(self, model: str):
-        self.name = f"a2ml/{model}"
+    def __init__(self, model: str, clearance: float = 0.01):
+        self.name = f"a2ml/{model}" + ("" if clearance == 0.01 else f"@{clearance * 1e3:g}mm")
         self.robot = a2ml.Robot.from_urdf(MODELS[model])
+        self.clearance = clearance
 
     def prepare(self, problem, scene):
         return problem["obstacles"]
@@ -121,7 +125,8 @@ class A2ml:
     def plan(self, problem, obstacles):
         start = time.perf_counter()
         try:
-            result = a2ml.rrt_connect(self.robot, obstacles, problem["start"], problem["goals"])
+            result = a2ml.rrt_connect(self.robot, obstacles, problem["start"], problem["goals"],
+                                      clearance=self.clearance)
         except a2ml.A2mlError:
             return time.perf_counter() - start, None
         return time.perf_counter() - start, result["waypoints"]
@@ -176,7 +181,8 @@ def main():
     parser.add_argument("--problems", type=int, default=100)
     parser.add_argument("--rounds", type=int, default=3)
     args = parser.parse_args()
-    planners = [A2ml("capsules"), A2ml("spheres")]
+    planners = [A2ml("capsules"), A2ml("spheres"), A2ml("spheres", clearance=0.0)]
+    compared = [p.name for p in planners if p.name.startswith("a2ml/spheres")]
     if vamp is None:
         print("vamp-planner does not import here: a2ml alone, no ratio")
     else:
@@ -185,16 +191,18 @@ def main():
           f"{len(planners)} planners, {args.rounds} rounds, paired medians")
     header = "| scene | " + " | ".join(f"{p.name} median, solved" for p in planners)
     if vamp is not None:
-        header += " | a2ml/spheres ÷ vamp"
+        header += "".join(f" | {name} ÷ vamp" for name in compared)
     print(header + " |")
     for name in args.scenes.split(","):
         rows = run_scene(name, planners, args.problems, args.rounds)
         cells = [f"{rows[p.name]['median'] * 1e3:.3f} ms, {rows[p.name]['solved']}"
                  for p in planners]
         if vamp is not None:
-            a, v = rows["a2ml/spheres"]["medians"], rows["vamp"]["medians"]
-            ratios = [a[i] / v[i] for i in a if i in v]
-            cells.append(f"{statistics.median(ratios):.2f}" if ratios else "-")
+            v = rows["vamp"]["medians"]
+            for compared_name in compared:
+                a = rows[compared_name]["medians"]
+                ratios = [a[i] / v[i] for i in a if i in v]
+                cells.append(f"{statistics.median(ratios):.2f}" if ratios else "-")
         print(f"| {name} | " + " | ".join(cells) + " |")
         for p in planners:
             for other, (valid, found) in rows[p.name]["valid_in"].items():
