@@ -178,32 +178,53 @@ impl Chart {
     /// of its tolerance. This is the distance from the path's locus, whatever the timing: a
     /// solver that lags behind its reference but stays on the line has not left it.
     pub fn deviation(&self, state: &ArmState, tolerance: &Tolerance) -> [Real; 3] {
-        let errors = |sigma: Real| -> [Real; 3] {
-            std::array::from_fn(|k| {
-                if !self.on_path[k] {
-                    return 0.0;
-                }
-                let v = self.variables[k];
-                goal_error(state, &[(v, self.references[k].at_fraction(sigma))])
-            })
+        // A path component whose reference does not move (a hold) is at the same value at
+        // every σ (σ scales a zero distance), so its error is measured once, not at every σ
+        // tried; goal components are 0.
+        let error_at = |k: usize, sigma: Real| -> Real {
+            let v = self.variables[k];
+            goal_error(state, &[(v, self.references[k].at_fraction(sigma))])
         };
-        let worst = |sigma: Real| -> Real {
-            let e = errors(sigma);
+        let fixed: [Option<Real>; 3] = std::array::from_fn(|k| {
+            if !self.on_path[k] {
+                Some(0.0)
+            } else if self.references[k].bell().distance() == 0.0 {
+                Some(error_at(k, 0.0))
+            } else {
+                None
+            }
+        });
+        let errors = |sigma: Real| -> [Real; 3] {
+            std::array::from_fn(|k| fixed[k].unwrap_or_else(|| error_at(k, sigma)))
+        };
+        let worst_of = |e: &[Real; 3]| -> Real {
             (0..3).map(|k| e[k] / tolerance.of(self.variables[k])).fold(0.0, Real::max)
         };
+        let worst = |sigma: Real| -> Real { worst_of(&errors(sigma)) };
         if self.sigma_max <= 0.0 {
             return errors(0.0);
         }
+        // The errors at the first candidate whose worst error is least (ties: the earlier),
+        // each distinct σ measured once.
         let best_of = |candidates: &[Real]| -> [Real; 3] {
-            let sigma = candidates.iter().copied().min_by(|a, b| worst(*a).total_cmp(&worst(*b)));
-            errors(sigma.unwrap_or(0.0))
+            let mut best: Option<([Real; 3], Real)> = None;
+            for (i, &sigma) in candidates.iter().enumerate() {
+                if candidates[..i].iter().any(|s| s.to_bits() == sigma.to_bits()) {
+                    continue;
+                }
+                let e = errors(sigma);
+                let w = worst_of(&e);
+                if best.is_none_or(|(_, b)| w.total_cmp(&b).is_lt()) {
+                    best = Some((e, w));
+                }
+            }
+            best.map_or_else(|| errors(0.0), |(e, _)| e)
         };
         // One moving path component (the usual case): the σ nearest in closed form; the other
         // path components are holds, the same at every σ.
-        let moving: Vec<usize> = (0..3)
-            .filter(|&k| self.on_path[k] && self.references[k].bell().distance() > 0.0)
-            .collect();
-        if let [k] = moving[..] {
+        let mut moving =
+            (0..3).filter(|&k| self.on_path[k] && self.references[k].bell().distance() > 0.0);
+        if let (Some(k), None) = (moving.next(), moving.next()) {
             let value = state.value(self.variables[k]);
             if let Some(sigma) = self.references[k].nearest_fraction(&value) {
                 // Angles come back in (-π, π]: a turn by more than π may be nearer a turn on.

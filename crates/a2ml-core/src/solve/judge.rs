@@ -52,8 +52,19 @@ pub fn tolerance_units(
 /// Pw, geodesic angle for rotations, (wrapped) angle difference; infinite where `q` has no
 /// state (a singular configuration).
 pub fn end_errors(robot: &Robot, problem: &SegmentProblem, q: &JointVector) -> [Real; 3] {
-    let Ok(state) = ArmState::at(robot, q) else { return [Real::INFINITY; 3] };
-    problem.components.map(|c| goal_error(&state, &[(c.variable, c.reference.end())]))
+    end_errors_at(problem, ArmState::at(robot, q).ok().as_ref())
+}
+
+/// [`end_errors`] of the arm in `state` (`None`: singular, infinite errors).
+fn end_errors_at(problem: &SegmentProblem, state: Option<&ArmState>) -> [Real; 3] {
+    let Some(state) = state else { return [Real::INFINITY; 3] };
+    problem.components.map(|c| goal_error(state, &[(c.variable, c.reference.end())]))
+}
+
+/// The arm's state at each of the trajectory's samples (`None` where it is singular): what
+/// the judgement and a segment's report read, computed once per sample.
+pub fn sample_states(robot: &Robot, trajectory: &Trajectory) -> Vec<Option<ArmState>> {
+    trajectory.positions().iter().map(|q| ArmState::at(robot, q).ok()).collect()
 }
 
 /// The largest distance of each path component from its path over the trajectory's samples,
@@ -66,12 +77,24 @@ pub fn path_errors(
     trajectory: &Trajectory,
     tolerance: &Tolerance,
 ) -> ([Real; 3], bool) {
+    path_errors_of(problem, chart, hard, &sample_states(robot, trajectory), tolerance)
+}
+
+/// [`path_errors`] over the samples' states ([`sample_states`]): infinite errors from a
+/// singular sample on.
+pub fn path_errors_of(
+    problem: &SegmentProblem,
+    chart: &Chart,
+    hard: bool,
+    states: &[Option<ArmState>],
+    tolerance: &Tolerance,
+) -> ([Real; 3], bool) {
     let mut worst = [0.0; 3];
-    for q in trajectory.positions() {
-        let Ok(state) = ArmState::at(robot, q) else {
+    for state in states {
+        let Some(state) = state else {
             return ([Real::INFINITY; 3], !hard);
         };
-        for (w, e) in worst.iter_mut().zip(chart.deviation(&state, tolerance)) {
+        for (w, e) in worst.iter_mut().zip(chart.deviation(state, tolerance)) {
             *w = Real::max(*w, e);
         }
     }
@@ -88,9 +111,26 @@ pub fn judge(
     tolerance: &Tolerance,
     fallback: &JointVector,
 ) -> Judgement {
-    let end = trajectory.positions().last().copied().unwrap_or(*fallback);
-    let errors = end_errors(robot, problem, &end);
-    let (path_errors, path_kept) = path_errors(robot, problem, chart, hard, trajectory, tolerance);
+    let states = sample_states(robot, trajectory);
+    judge_states(robot, problem, chart, hard, &states, tolerance, fallback)
+}
+
+/// [`judge`] over the states of the trajectory's samples ([`sample_states`]); the end is
+/// the last sample's, else `fallback`'s.
+pub fn judge_states(
+    robot: &Robot,
+    problem: &SegmentProblem,
+    chart: &Chart,
+    hard: bool,
+    states: &[Option<ArmState>],
+    tolerance: &Tolerance,
+    fallback: &JointVector,
+) -> Judgement {
+    let errors = match states.last() {
+        Some(end) => end_errors_at(problem, end.as_ref()),
+        None => end_errors(robot, problem, fallback),
+    };
+    let (path_errors, path_kept) = path_errors_of(problem, chart, hard, states, tolerance);
     Judgement {
         errors,
         reached: reached(tolerance, &problem.components, &errors),

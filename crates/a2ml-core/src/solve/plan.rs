@@ -772,16 +772,17 @@ impl Solver<'_> {
             segment: job.k,
             source,
         })?;
-        let (path_errors, path_kept) = judge::path_errors(
-            self.robot,
+        let states = judge::sample_states(self.robot, &solution.trajectory);
+        let (path_errors, path_kept) = judge::path_errors_of(
             &job.problem,
             &job.chart,
             job.hard,
-            &solution.trajectory,
+            &states,
             &self.options.tolerance,
         );
         Ok(Solved {
             solver: SolverChoice::Qp,
+            states,
             trajectory: solution.trajectory,
             errors: solution.errors,
             path_errors,
@@ -927,17 +928,19 @@ impl Solver<'_> {
         stalled: bool,
         rrt: Option<RrtStats>,
     ) -> Solved {
-        let Judgement { errors, reached, path_errors, path_kept } = judge::judge(
+        let states = judge::sample_states(self.robot, &trajectory);
+        let Judgement { errors, reached, path_errors, path_kept } = judge::judge_states(
             self.robot,
             &job.problem,
             &job.chart,
             job.hard,
-            &trajectory,
+            &states,
             &self.options.tolerance,
             &self.q,
         );
         Solved {
             solver,
+            states,
             trajectory,
             errors,
             path_errors,
@@ -1007,7 +1010,11 @@ impl Solver<'_> {
             slowed_down: 1.0,
             joint_jerk: 0.0,
             wrist_jerk: 0.0,
-            speed_peaks: featured_peaks(self.robot, &segment_focus(job), &solution.trajectory),
+            speed_peaks: featured_peaks(
+                &segment_focus(job),
+                solution.trajectory.times(),
+                &solution.states,
+            ),
         }
     }
 }
@@ -1084,12 +1091,9 @@ fn segment_focus(job: &Job) -> Variable {
         .unwrap_or(Variable::Pw)
 }
 
-/// The number of peaks of `variable`'s speed over the trajectory's samples (the change of its
-/// value between samples, over their interval).
-fn featured_peaks(robot: &Robot, variable: &Variable, trajectory: &Trajectory) -> usize {
-    let states: Vec<Option<ArmState>> =
-        trajectory.positions().iter().map(|q| ArmState::at(robot, q).ok()).collect();
-    let times = trajectory.times();
+/// The number of peaks of `variable`'s speed over a trajectory's samples (the change of its
+/// value between samples, over their interval), from their `times` and `states`.
+fn featured_peaks(variable: &Variable, times: &[Real], states: &[Option<ArmState>]) -> usize {
     let speeds: Vec<Real> = (1..states.len())
         .map(|k| match (&states[k - 1], &states[k]) {
             (Some(a), Some(b)) => {
@@ -1143,6 +1147,9 @@ struct Solved {
     solver: SolverChoice,
     /// From time 0.
     trajectory: Trajectory,
+    /// The arm's state at each sample of the trajectory (`None` where singular), which the
+    /// judgement and the report read.
+    states: Vec<Option<ArmState>>,
     errors: [Real; 3],
     /// Largest distance of each component from its path (0 for goals).
     path_errors: [Real; 3],
