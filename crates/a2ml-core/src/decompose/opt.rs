@@ -10,7 +10,7 @@
 //! by [`OptOptions::limit_margin`]. A one-dimensional search over θsw first
 //! samples the closed-form feasible swivel intervals.
 
-use crate::collision::{CollisionScene, min_distance};
+use crate::collision::{CollisionModel, CollisionScene, min_distance};
 use crate::kinematics::{
     CpsaState, HatState, KinematicsError, arm_pose, cpsa_state, cpsa_to_hat, hat_state,
     hat_to_cpsa, ik_cpsa, ik_cpsa_nearest, swivel_intervals,
@@ -206,6 +206,10 @@ struct Search<'a> {
     goals: &'a [(Variable, Target)],
     options: &'a OptOptions,
     scene: Option<&'a CollisionScene>,
+    /// The scene's collision model, for the motion bound of [`Search::clear`].
+    model: Option<&'a CollisionModel>,
+    /// The last configuration whose clearance was measured, and that clearance (m).
+    measured: Option<(JointVector, Real)>,
     /// The distance (m) the end state keeps: the safety distance, with [`goal_margin`] where
     /// an end with that room exists.
     kept: Real,
@@ -353,11 +357,26 @@ impl Search<'_> {
         })
     }
 
-    /// Whether the arm at `q` keeps the clearance from the scene and itself.
-    fn clear(&self, q: &JointVector) -> bool {
+    /// Whether the arm at `q` keeps the clearance from the scene and itself. The search
+    /// evaluates configurations close to one another (finite differences, small steps): one
+    /// whose distance is bounded from below by the last one measured
+    /// ([`crate::trajectory::clearance_bound`]) at the clearance or more is clear without
+    /// measuring.
+    fn clear(&mut self, q: &JointVector) -> bool {
         let Some(scene) = self.scene else { return true };
-        min_distance(self.robot, &arm_pose(self.robot, q), scene)
-            .is_none_or(|(d, ..)| d >= self.kept)
+        if let (Some(model), Some((at, distance))) = (self.model, &self.measured) {
+            let bound = crate::trajectory::clearance_bound(model, *distance, at, q);
+            if bound > 0.0 && bound >= self.kept {
+                return true;
+            }
+        }
+        match min_distance(self.robot, &arm_pose(self.robot, q), scene) {
+            Some((d, ..)) => {
+                self.measured = Some((*q, d));
+                d >= self.kept
+            }
+            None => true,
+        }
     }
 
     fn residual(&mut self, x: &[Real], out: &mut Vec<Real>) -> Option<(ArmState, JointVector)> {
@@ -668,6 +687,7 @@ pub fn opt1(
         .ok_or_else(|| OptError::Unsupported("Opt1 needs goals in two spaces".into()))?;
     let start_state = ArmState::at(robot, start).map_err(OptError::SingularStart)?;
     let free = space.variables().into_iter().filter(|v| !g1.iter().any(|(f, _)| f == v)).collect();
+    let model = scene.map(|s| CollisionModel::new(robot, s));
     Search {
         robot,
         start_q: *start,
@@ -680,6 +700,8 @@ pub fn opt1(
         goals: g2,
         options,
         scene,
+        model: model.as_ref(),
+        measured: None,
         kept: options.clearance,
         evaluations: 0,
         check_path: true,
@@ -755,6 +777,7 @@ pub fn opt2(
             _ => None,
         })
         .collect();
+    let model = scene.map(|s| CollisionModel::new(robot, s));
     Search {
         robot,
         start_q: *start,
@@ -767,6 +790,8 @@ pub fn opt2(
         goals: g,
         options,
         scene,
+        model: model.as_ref(),
+        measured: None,
         kept: options.clearance,
         evaluations: 0,
         check_path: true,

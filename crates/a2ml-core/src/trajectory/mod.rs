@@ -460,7 +460,7 @@ const MEASURE_SLACK: Real = 1e-4;
 /// the two configurations, so no pair (a self pair's two capsules both moving) comes more
 /// than twice that closer, less what the measure itself may be off by ([`MEASURE_SLACK`],
 /// twice). Only a positive bound says anything: a penetration's depth has no such slack.
-fn clearance_bound(
+pub(crate) fn clearance_bound(
     model: &collision::CollisionModel,
     distance: Real,
     measured: &JointVector,
