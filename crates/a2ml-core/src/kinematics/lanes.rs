@@ -646,7 +646,7 @@ mod tests {
         let expected = Constant::Permutation { source: [1, 0, 2], sign: [1.0, -1.0, 1.0] };
         assert_eq!(Constant::of(&turn), expected);
         // A URDF's 1.570796327 is 2e-10 off π/2: a general rotation.
-        let (s, c) = 1.570_796_327_f64.sin_cos();
+        let (s, c) = (std::f64::consts::FRAC_PI_2 + 2e-10).sin_cos();
         let turn = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
         assert_eq!(Constant::of(&turn), Constant::General(turn));
         // Two columns from one row is no permutation.
