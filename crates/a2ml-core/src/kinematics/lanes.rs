@@ -36,8 +36,68 @@ type LaneMatrix = [[Lane; 3]; 3];
 /// this joint's, before the turn about z.
 #[derive(Debug, Clone, Copy)]
 struct Step {
-    rotation: [[Real; 3]; 3],
+    rotation: Constant,
     translation: [Real; 3],
+}
+
+/// A constant rotation of the chain. Most joint frames of the shipped arms are turned by 0 or
+/// ±π/2, which makes the rotation a signed permutation: a product by it is then a choice of
+/// columns and sign flips instead of 27 products and 18 sums per lane group.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Constant {
+    /// Column j of `m c` is `sign[j]` times column `source[j]` of `m`.
+    Permutation { source: [usize; 3], sign: [Real; 3] },
+    /// Any other rotation, row-major.
+    General([[Real; 3]; 3]),
+}
+
+/// Entries this close to 0 or ±1 are taken as exactly that: the rounding of a ±π/2 turn
+/// (cos(π/2) is 6.1e-17 in doubles) and of the aligning products, a few ulps. Taking them as
+/// exact moves a product by at most 3 · SNAP of its size, far below the 1e-12 the batched rows
+/// promise.
+const SNAP: Real = 4.0 * Real::EPSILON;
+
+impl Constant {
+    /// `c` as a signed permutation if each column has one entry within [`SNAP`] of ±1 and the
+    /// others within [`SNAP`] of 0, in different rows; else as it is.
+    fn of(c: &[[Real; 3]; 3]) -> Self {
+        let mut source = [0; 3];
+        let mut sign = [0.0; 3];
+        let mut used = [false; 3];
+        for j in 0..3 {
+            let unit: Vec<usize> =
+                (0..3).filter(|&r| (c[r][j].abs() - 1.0).abs() <= SNAP).collect();
+            let zeros = (0..3).filter(|&r| c[r][j].abs() <= SNAP).count();
+            match unit[..] {
+                [r] if zeros == 2 && !used[r] => {
+                    used[r] = true;
+                    source[j] = r;
+                    sign[j] = c[r][j].signum();
+                }
+                _ => return Self::General(*c),
+            }
+        }
+        Self::Permutation { source, sign }
+    }
+
+    /// `m c`.
+    #[inline(always)]
+    fn times(&self, m: &LaneMatrix) -> LaneMatrix {
+        match self {
+            Self::Permutation { source, sign } => std::array::from_fn(|i| {
+                std::array::from_fn(|j| m[i][source[j]].map(|v| v * sign[j]))
+            }),
+            Self::General(c) => times_constant(m, c),
+        }
+    }
+}
+
+/// `t` (m) with the components within [`SNAP`] of its size, or under [`SNAP`] metres (a
+/// femtometre: the residue of turning an offset along an axis by a rounded ±π/2), taken as 0,
+/// which [`apply`] skips.
+fn snapped(t: [Real; 3]) -> [Real; 3] {
+    let size = t.iter().fold(1.0, |a: Real, v| a.max(v.abs()));
+    t.map(|v| if v.abs() <= SNAP * size { 0.0 } else { v })
 }
 
 /// The robot's chain prepared for [`LANES`] configurations at a time.
@@ -52,7 +112,7 @@ pub struct BatchedChain {
     /// W in aligned frame 6.
     wrist: [Real; 3],
     /// Ow from aligned frame 7: the hand's rotation in that frame.
-    hand: [[Real; 3]; 3],
+    hand: Constant,
 }
 
 /// What forward kinematics gives for one group of lanes, in {b}.
@@ -89,6 +149,22 @@ fn values_of(v: &Vector3) -> [Real; 3] {
 impl BatchedChain {
     /// The chain of `robot`.
     pub fn new(robot: &Robot) -> Self {
+        Self::from_constants(robot, Constant::of, snapped)
+    }
+
+    /// The chain of `robot` with every constant a [`Constant::General`] product and no
+    /// component skipped: the slow exact kernel the specialised one is tested against.
+    #[cfg(test)]
+    fn general(robot: &Robot) -> Self {
+        Self::from_constants(robot, |c| Constant::General(*c), |t| t)
+    }
+
+    /// The chain, its rotations taken by `rotation` and its offsets by `offset`.
+    fn from_constants(
+        robot: &Robot,
+        rotation: impl Fn(&[[Real; 3]; 3]) -> Constant,
+        offset: impl Fn([Real; 3]) -> [Real; 3],
+    ) -> Self {
         let align: [Matrix3; DOF] = std::array::from_fn(|k| aligning(&robot.joints[k].axis));
         // A_{k-1}ᵀ for frame k, the identity for {b}.
         let aligned_from_frame =
@@ -97,16 +173,16 @@ impl BatchedChain {
             let p = &robot.joints[k].parent_from_joint;
             let before = aligned_from_frame(k);
             Step {
-                rotation: rows_of(&(before * p.rotation.matrix() * align[k])),
-                translation: values_of(&(before * p.translation.vector)),
+                rotation: rotation(&rows_of(&(before * p.rotation.matrix() * align[k]))),
+                translation: offset(values_of(&(before * p.translation.vector))),
             }
         });
         let s = &robot.structure;
         Self {
             steps,
-            elbow: values_of(&(aligned_from_frame(3) * s.elbow_in_frame3)),
-            wrist: values_of(&(aligned_from_frame(6) * s.wrist_in_frame6)),
-            hand: rows_of(&(aligned_from_frame(DOF) * robot.frame7_from_hand.matrix())),
+            elbow: offset(values_of(&(aligned_from_frame(3) * s.elbow_in_frame3))),
+            wrist: offset(values_of(&(aligned_from_frame(6) * s.wrist_in_frame6))),
+            hand: rotation(&rows_of(&(aligned_from_frame(DOF) * robot.frame7_from_hand.matrix()))),
         }
     }
 
@@ -233,7 +309,7 @@ impl BatchedChain {
         let (mut elbow, mut wrist) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3]);
         for (k, step) in self.steps.iter().enumerate() {
             translation = apply(&rotation, &step.translation, &translation);
-            let m = times_constant(&rotation, &step.rotation);
+            let m = step.rotation.times(&rotation);
             let (sin, cos) = sin_cos(&joints[k]);
             for i in 0..3 {
                 let (x, y) = (&m[i][0], &m[i][1]);
@@ -264,7 +340,7 @@ impl BatchedChain {
                 linear[k][2][l] = z[0][l] * d[1] - z[1][l] * d[0];
             }
         }
-        GroupPose { axes, linear, elbow, wrist, hand: times_constant(&rotation, &self.hand) }
+        GroupPose { axes, linear, elbow, wrist, hand: self.hand.times(&rotation) }
     }
 }
 
@@ -282,16 +358,20 @@ fn times_constant(m: &LaneMatrix, c: &[[Real; 3]; 3]) -> LaneMatrix {
     out
 }
 
-/// `m v + t` with v the same in every lane.
+/// `m v + t` with v the same in every lane, its zero components skipped (the shipped arms'
+/// offsets mostly lie along one axis): with m finite a skipped term is ±0, which changes no
+/// sum but the sign of a zero.
 #[inline(always)]
 fn apply(m: &LaneMatrix, v: &[Real; 3], t: &LaneVector) -> LaneVector {
-    let mut out = [[0.0; LANES]; 3];
-    for i in 0..3 {
-        for l in 0..LANES {
-            out[i][l] = t[i][l] + (m[i][0][l] * v[0] + m[i][1][l] * v[1] + m[i][2][l] * v[2]);
+    let mut sum = [[0.0; LANES]; 3];
+    for (r, &value) in v.iter().enumerate().filter(|(_, value)| **value != 0.0) {
+        for i in 0..3 {
+            for l in 0..LANES {
+                sum[i][l] += m[i][r][l] * value;
+            }
         }
     }
-    out
+    std::array::from_fn(|i| std::array::from_fn(|l| t[i][l] + sum[i][l]))
 }
 
 /// Lane `lane`'s hand frame {W} as a row-major 4x4 homogeneous matrix.
@@ -552,6 +632,51 @@ mod tests {
             });
             assert_eq!(bits(&frames), bits(&portable_frames), "{name}");
             assert_eq!(bits(&jacobians), bits(&portable_jacobians), "{name}");
+        }
+    }
+
+    #[test]
+    fn signed_permutations_are_recognised_and_nothing_else() {
+        let swap = [[0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0]];
+        let expected = Constant::Permutation { source: [2, 0, 1], sign: [-1.0, -1.0, 1.0] };
+        assert_eq!(Constant::of(&swap), expected);
+        // A turn by π/2 in doubles: cos is 6.1e-17, within the snap.
+        let (s, c) = std::f64::consts::FRAC_PI_2.sin_cos();
+        let turn = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+        let expected = Constant::Permutation { source: [1, 0, 2], sign: [1.0, -1.0, 1.0] };
+        assert_eq!(Constant::of(&turn), expected);
+        // A URDF's 1.570796327 is 2e-10 off π/2: a general rotation.
+        let (s, c) = (std::f64::consts::FRAC_PI_2 + 2e-10).sin_cos();
+        let turn = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+        assert_eq!(Constant::of(&turn), Constant::General(turn));
+        // Two columns from one row is no permutation.
+        let twice = [[1.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 0.0]];
+        assert_eq!(Constant::of(&twice), Constant::General(twice));
+        assert_eq!(snapped([6e-17, 0.2, -3e-16]), [0.0, 0.2, 0.0]);
+        assert_eq!(snapped([1e-3, 0.0, 0.0]), [1e-3, 0.0, 0.0]);
+    }
+
+    /// The specialised products against the full ones: the same values (a zero's sign aside)
+    /// where every snapped constant was exactly 0 or ±1 (the iiwa14's), else within rounding.
+    #[test]
+    fn the_specialised_chain_gives_the_full_products_values() {
+        for name in ROBOTS {
+            let robot = robot(name);
+            let (fast, slow) = (BatchedChain::new(&robot), BatchedChain::general(&robot));
+            let count = 3 * LANES + 1;
+            let q = configurations(&robot, count);
+            let run = |chain: &BatchedChain| {
+                let (mut frames, mut jacobians) =
+                    (vec![0.0; count * FRAME_VALUES], vec![0.0; count * JACOBIAN_VALUES]);
+                chain.hand_frames_and_jacobians(&q, &mut frames, &mut jacobians);
+                (frames, jacobians)
+            };
+            let (fast, slow) = (run(&fast), run(&slow));
+            let d = largest_difference(&fast.0, &slow.0).max(largest_difference(&fast.1, &slow.1));
+            assert!(d <= 1e-14, "{name}: {d:e}");
+            if name == "iiwa14" {
+                assert!(fast == slow, "{name}: the exact constants change a value");
+            }
         }
     }
 
