@@ -33,6 +33,8 @@ pub struct CollisionModel {
     convex: Vec<Convex>,
     /// Sorted by the pair of groups, so that [`GroupPair`] ranges cover them.
     self_pairs: Vec<SelfPair>,
+    /// `self_pairs`' fields the loop over all of them reads, in the same order.
+    hot: Vec<HotPair>,
     group_pairs: Vec<GroupPair>,
 }
 
@@ -405,7 +407,18 @@ impl CollisionModel {
                 }
             }
         }
-        Self { chain, links, groups, spheres, capsules, convex, self_pairs, group_pairs }
+        let hot = self_pairs
+            .iter()
+            .map(|p| HotPair {
+                link: p.link,
+                other: p.other,
+                distal: p.distal,
+                start: p.joints.start,
+                bounds: p.bounds,
+                floor: p.floor,
+            })
+            .collect();
+        Self { chain, links, groups, spheres, capsules, convex, self_pairs, hot, group_pairs }
     }
 }
 
@@ -602,6 +615,7 @@ impl CollisionModel {
         // A capsule is in many self pairs: its bounding sphere's centre placed once, and the
         // capsule itself once, only for a pair the bounding spheres do not settle.
         let mut centers = Centers::new();
+        let rates = speed.map(|speed| Rates::new(&self.links, speed));
         let mut placed = Placed::new();
         let bounding = |group: usize| {
             self.groups.get(group).map(|g| (frames[g.frame].apply(&g.center), g.bound))
@@ -625,12 +639,18 @@ impl CollisionModel {
                     continue;
                 }
             }
-            for pair in &self.self_pairs[group_pair.pairs.clone()] {
+            for (k, pair) in self.hot[group_pair.pairs.clone()].iter().enumerate() {
                 // Sorted by floor: the rest are higher still.
                 if pair.floor >= limit {
                     break;
                 }
-                let loose = loose(&pair.levers);
+                let levers = || &self.self_pairs[group_pair.pairs.start + k].levers;
+                let loose = match (speed, &rates) {
+                    (Some(_), Some(rates)) if pair.distal < Rates::CAPACITY => {
+                        Motion::at_most(rates.rate(pair.distal, pair.start))
+                    }
+                    _ => loose(levers()),
+                };
                 // Only bounding spheres closer than this (centre to centre) may lower `best`;
                 // compared squared, so that most pairs cost no square root.
                 let reach = loose.threshold(best) + offset + pair.bounds;
@@ -647,7 +667,8 @@ impl CollisionModel {
                 let moved = if pair.distal == pair.link { &link } else { &other };
                 let slack = link.distance(&other) - offset;
                 if loose.reach(slack) < best {
-                    let exact = exact(moved, &pair.levers, pair.joints.clone());
+                    let joints = pair.start..self.links[pair.distal].frame;
+                    let exact = exact(moved, levers(), joints);
                     best = best.min(exact.reach(slack));
                     if best < least {
                         return best;
@@ -658,6 +679,52 @@ impl CollisionModel {
         }
         best
     }
+}
+
+/// Per capsule (the first [`Rates::CAPACITY`]) and first joint s, Σ_{j≥s} lever_j |dq_j|: the
+/// configuration-independent rate of a self pair whose distal capsule it is and whose joints
+/// start at s (its levers are the distal's from s on, and a capsule's are zero past its frame),
+/// for every pair at the cost of one table per query. Raised by a few units in the last place,
+/// so that a rate summed in another order than the pair's own dot product is never below it:
+/// a pair is then left out only where the dot product would leave it out.
+struct Rates {
+    suffix: [[Real; DOF]; Self::CAPACITY],
+}
+
+impl Rates {
+    const CAPACITY: usize = 64;
+
+    /// Over 16 terms of one sign, rounding moves a sum by far less than this.
+    const RAISE: Real = 1.0 + 64.0 * Real::EPSILON;
+
+    fn new(links: &[LinkCapsule], speed: &JointVector) -> Self {
+        let mut suffix = [[0.0; DOF]; Self::CAPACITY];
+        for (rates, link) in suffix.iter_mut().zip(links) {
+            let mut sum = 0.0;
+            for j in (0..DOF).rev() {
+                sum += link.levers[j] * speed[j];
+                rates[j] = sum * Self::RAISE;
+            }
+        }
+        Self { suffix }
+    }
+
+    fn rate(&self, distal: usize, start: usize) -> Real {
+        self.suffix[distal][start]
+    }
+}
+
+/// What the self-pair loop reads of every pair, packed apart from the levers and joints that
+/// only the pairs the bounding spheres do not settle need (a third of a [`SelfPair`]'s bytes).
+#[derive(Debug, Clone, Copy)]
+struct HotPair {
+    link: usize,
+    other: usize,
+    distal: usize,
+    /// The first joint between the two frames.
+    start: usize,
+    bounds: Real,
+    floor: Real,
 }
 
 /// The first [`Placed::CAPACITY`] capsules placed at most once per query, on the stack; the
