@@ -33,6 +33,8 @@ pub struct CollisionModel {
     convex: Vec<Convex>,
     /// Sorted by the pair of groups, so that [`GroupPair`] ranges cover them.
     self_pairs: Vec<SelfPair>,
+    /// `self_pairs`' fields the loop over all of them reads, in the same order.
+    hot: Vec<HotPair>,
     group_pairs: Vec<GroupPair>,
 }
 
@@ -60,6 +62,8 @@ struct GroupPair {
     pairs: std::ops::Range<usize>,
     /// The largest levers of those pairs.
     levers: JointVector,
+    /// The smallest [`SelfPair::floor`] of those pairs (the first's: they are sorted by it).
+    floor: Real,
 }
 
 /// A box or cylinder: the parry body, and what the closed forms for a point need.
@@ -251,6 +255,9 @@ struct SelfPair {
     levers: JointVector,
     /// The sum of the two bounding spheres' radii.
     bounds: Real,
+    /// A lower bound of the pair's signed distance at every configuration within the limits
+    /// ([`floors`]); −∞ where none is known.
+    floor: Real,
 }
 
 #[derive(Debug, Clone)]
@@ -335,13 +342,22 @@ impl CollisionModel {
                     if joints.contains(&j) { links[distal].levers[j] } else { 0.0 }
                 });
                 let bounds = links[link].bound + links[other].bound;
-                SelfPair { link, other, distal, joints, levers, bounds }
+                SelfPair { link, other, distal, joints, levers, bounds, floor: Real::NEG_INFINITY }
             })
             .collect();
+        let floors = floors(robot, &chain, &links, &self_pairs);
+        for (pair, floor) in self_pairs.iter_mut().zip(floors) {
+            pair.floor = floor;
+        }
         let group_of = |capsule: usize| groups.iter().position(|g| g.members.contains(&capsule));
-        // A base capsule never moves: it has no group, and stands for itself.
+        // A base capsule never moves: it has no group, and stands for itself. Within a pair of
+        // groups the lowest floor first, so that a check stops at the first floor too high.
         let key = |pair: &SelfPair| (group_of(pair.link), group_of(pair.other));
-        self_pairs.sort_by_key(|p| (key(p), p.link, p.other));
+        self_pairs.sort_by(|p, r| {
+            (key(p).cmp(&key(r)))
+                .then(p.floor.total_cmp(&r.floor))
+                .then((p.link, p.other).cmp(&(r.link, r.other)))
+        });
         let mut group_pairs: Vec<GroupPair> = Vec::new();
         for (k, pair) in self_pairs.iter().enumerate() {
             let (a, b) = key(pair);
@@ -351,7 +367,12 @@ impl CollisionModel {
                     last.pairs.end = k + 1;
                     last.levers = last.levers.sup(&pair.levers);
                 }
-                _ => group_pairs.push(GroupPair { groups, pairs: k..k + 1, levers: pair.levers }),
+                _ => group_pairs.push(GroupPair {
+                    groups,
+                    pairs: k..k + 1,
+                    levers: pair.levers,
+                    floor: pair.floor,
+                }),
             }
         }
         let (mut spheres, mut capsules, mut convex) = (Vec::new(), Vec::new(), Vec::new());
@@ -386,7 +407,18 @@ impl CollisionModel {
                 }
             }
         }
-        Self { chain, links, groups, spheres, capsules, convex, self_pairs, group_pairs }
+        let hot = self_pairs
+            .iter()
+            .map(|p| HotPair {
+                link: p.link,
+                other: p.other,
+                distal: p.distal,
+                start: p.joints.start,
+                bounds: p.bounds,
+                floor: p.floor,
+            })
+            .collect();
+        Self { chain, links, groups, spheres, capsules, convex, self_pairs, hot, group_pairs }
     }
 }
 
@@ -583,12 +615,23 @@ impl CollisionModel {
         // A capsule is in many self pairs: its bounding sphere's centre placed once, and the
         // capsule itself once, only for a pair the bounding spheres do not settle.
         let mut centers = Centers::new();
+        let rates = speed.map(|speed| Rates::new(&self.links, speed));
         let mut placed = Placed::new();
         let bounding = |group: usize| {
             self.groups.get(group).map(|g| (frames[g.frame].apply(&g.center), g.bound))
         };
         for group_pair in &self.group_pairs {
             let loose_pair = loose(&group_pair.levers);
+            // A pair whose floor is this high cannot lower `best`: its slack is at least the
+            // floor's, and its own rate is at most the group pair's, which can only raise a
+            // positive threshold (at or below zero a faster motion lowers it: no cut there).
+            let floor_limit = |best: Real| {
+                if best > 0.0 { loose_pair.threshold(best) + offset } else { Real::INFINITY }
+            };
+            let mut limit = floor_limit(best);
+            if group_pair.floor >= limit {
+                continue;
+            }
             if let (Some((ca, ba)), Some((cb, bb))) =
                 (bounding(group_pair.groups.0), bounding(group_pair.groups.1))
             {
@@ -596,8 +639,18 @@ impl CollisionModel {
                     continue;
                 }
             }
-            for pair in &self.self_pairs[group_pair.pairs.clone()] {
-                let loose = loose(&pair.levers);
+            for (k, pair) in self.hot[group_pair.pairs.clone()].iter().enumerate() {
+                // Sorted by floor: the rest are higher still.
+                if pair.floor >= limit {
+                    break;
+                }
+                let levers = || &self.self_pairs[group_pair.pairs.start + k].levers;
+                let loose = match (speed, &rates) {
+                    (Some(_), Some(rates)) if pair.distal < Rates::CAPACITY => {
+                        Motion::at_most(rates.rate(pair.distal, pair.start))
+                    }
+                    _ => loose(levers()),
+                };
                 // Only bounding spheres closer than this (centre to centre) may lower `best`;
                 // compared squared, so that most pairs cost no square root.
                 let reach = loose.threshold(best) + offset + pair.bounds;
@@ -614,16 +667,64 @@ impl CollisionModel {
                 let moved = if pair.distal == pair.link { &link } else { &other };
                 let slack = link.distance(&other) - offset;
                 if loose.reach(slack) < best {
-                    let exact = exact(moved, &pair.levers, pair.joints.clone());
+                    let joints = pair.start..self.links[pair.distal].frame;
+                    let exact = exact(moved, levers(), joints);
                     best = best.min(exact.reach(slack));
                     if best < least {
                         return best;
                     }
+                    limit = floor_limit(best);
                 }
             }
         }
         best
     }
+}
+
+/// Per capsule (the first [`Rates::CAPACITY`]) and first joint s, Σ_{j≥s} lever_j |dq_j|: the
+/// configuration-independent rate of a self pair whose distal capsule it is and whose joints
+/// start at s (its levers are the distal's from s on, and a capsule's are zero past its frame),
+/// for every pair at the cost of one table per query. Raised by a few units in the last place,
+/// so that a rate summed in another order than the pair's own dot product is never below it:
+/// a pair is then left out only where the dot product would leave it out.
+struct Rates {
+    suffix: [[Real; DOF]; Self::CAPACITY],
+}
+
+impl Rates {
+    const CAPACITY: usize = 64;
+
+    /// Over 16 terms of one sign, rounding moves a sum by far less than this.
+    const RAISE: Real = 1.0 + 64.0 * Real::EPSILON;
+
+    fn new(links: &[LinkCapsule], speed: &JointVector) -> Self {
+        let mut suffix = [[0.0; DOF]; Self::CAPACITY];
+        for (rates, link) in suffix.iter_mut().zip(links) {
+            let mut sum = 0.0;
+            for j in (0..DOF).rev() {
+                sum += link.levers[j] * speed[j];
+                rates[j] = sum * Self::RAISE;
+            }
+        }
+        Self { suffix }
+    }
+
+    fn rate(&self, distal: usize, start: usize) -> Real {
+        self.suffix[distal][start]
+    }
+}
+
+/// What the self-pair loop reads of every pair, packed apart from the levers and joints that
+/// only the pairs the bounding spheres do not settle need (a third of a [`SelfPair`]'s bytes).
+#[derive(Debug, Clone, Copy)]
+struct HotPair {
+    link: usize,
+    other: usize,
+    distal: usize,
+    /// The first joint between the two frames.
+    start: usize,
+    bounds: Real,
+    floor: Real,
 }
 
 /// The first [`Placed::CAPACITY`] capsules placed at most once per query, on the stack; the
@@ -672,6 +773,65 @@ impl Centers {
         }
         self.slots[i]
     }
+}
+
+/// Grid points per joint of [`floors`], for pairs one joint apart and two.
+const FLOOR_GRID: [usize; 2] = [48, 12];
+
+/// Per self pair, a lower bound of its signed distance at every configuration within the
+/// limits, for the pairs one or two joints move relative to each other (−∞ for the others, and
+/// where a limit is not finite): the smallest distance on a grid of cell centres, less the
+/// farthest the distal capsule can move from a centre within its cell (Σ lever_j h_j/2, the
+/// configuration-independent motion bound of [`Motion`]). The joints before both move the two
+/// as one, so any values of them serve; the frames of a grid point are shared by every pair
+/// of its joints.
+fn floors(
+    robot: &Robot,
+    chain: &AlignedChain,
+    links: &[LinkCapsule],
+    pairs: &[SelfPair],
+) -> Vec<Real> {
+    let mut floors = vec![Real::NEG_INFINITY; pairs.len()];
+    let (lower, upper) = (robot.lower(), robot.upper());
+    let mut ranges: Vec<(usize, usize)> = pairs
+        .iter()
+        .filter(|p| (1..=FLOOR_GRID.len()).contains(&p.joints.len()))
+        .map(|p| (p.joints.start, p.joints.end))
+        .collect();
+    ranges.sort_unstable();
+    ranges.dedup();
+    let mut posed: Vec<Option<Posed>> = vec![None; links.len()];
+    for (start, end) in ranges {
+        let members: Vec<usize> =
+            (0..pairs.len()).filter(|&k| pairs[k].joints == (start..end)).collect();
+        let n = FLOOR_GRID[end - start - 1];
+        let width = |j: usize| (upper[j] - lower[j]) / n as Real;
+        if (start..end).any(|j| !width(j).is_finite()) {
+            continue;
+        }
+        let mut q = crate::robot::home(&robot.joints);
+        let mut smallest = vec![Real::INFINITY; members.len()];
+        for cell in 0..n.pow((end - start) as u32) {
+            let mut rest = cell;
+            for j in start..end {
+                q[j] = lower[j] + ((rest % n) as Real + 0.5) * width(j);
+                rest /= n;
+            }
+            let frames = chain.frames(&q);
+            posed.iter_mut().for_each(|p| *p = None);
+            for (m, &k) in members.iter().enumerate() {
+                let (link, other) = (pairs[k].link, pairs[k].other);
+                let a = *posed[link].get_or_insert_with(|| links[link].posed(&frames));
+                let b = *posed[other].get_or_insert_with(|| links[other].posed(&frames));
+                smallest[m] = smallest[m].min(a.distance(&b));
+            }
+        }
+        for (m, &k) in members.iter().enumerate() {
+            let within_cell: Real = (start..end).map(|j| pairs[k].levers[j] * 0.5 * width(j)).sum();
+            floors[k] = smallest[m] - within_cell - ROUNDING;
+        }
+    }
+    floors
 }
 
 /// {b} from a parry pose's axes.

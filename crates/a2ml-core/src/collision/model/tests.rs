@@ -239,3 +239,130 @@ fn random_solid(
     };
     (center, shape)
 }
+
+/// The arm models whose self pairs the floors are tested on: VAMP's 59-sphere Panda (1028
+/// pairs) and two capsule arms.
+fn floor_robots() -> Vec<Robot> {
+    let root = format!("{}/../..", env!("CARGO_MANIFEST_DIR"));
+    ["tests/data/panda_spheres/panda_spheres.urdf", "robots/panda.urdf", "robots/iiwa14.urdf"]
+        .iter()
+        .map(|path| Robot::from_urdf_file(format!("{root}/{path}")).expect("robot loads"))
+        .collect()
+}
+
+/// The same model with no floors: every self pair checked as before them.
+fn without_floors(model: &CollisionModel) -> CollisionModel {
+    let mut plain = model.clone();
+    plain.self_pairs.iter_mut().for_each(|p| p.floor = Real::NEG_INFINITY);
+    plain.hot.iter_mut().for_each(|p| p.floor = Real::NEG_INFINITY);
+    plain.group_pairs.iter_mut().for_each(|g| g.floor = Real::NEG_INFINITY);
+    plain
+}
+
+/// No self pair comes closer than its floor, at random configurations and at the corners of
+/// the limits, and the spheres' floors rule out a good share of the pairs two joints apart
+/// (more than a quarter above 5 cm: fewer would mean the grid bound had lost its use).
+#[test]
+fn self_pairs_keep_their_floors() {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(29);
+    for (r, robot) in floor_robots().iter().enumerate() {
+        let model = CollisionModel::new(robot, &CollisionScene::new(&[]));
+        let (lower, upper) = (robot.lower(), robot.upper());
+        let mut tightest = Real::INFINITY;
+        for k in 0..3000 {
+            let q = JointVector::from_fn(|i, _| match k % 3 {
+                0 => {
+                    if rng.random_bool(0.5) {
+                        lower[i]
+                    } else {
+                        upper[i]
+                    }
+                }
+                _ => rng.random_range(lower[i]..upper[i]),
+            });
+            let frames = model.chain.frames(&q);
+            for pair in model.self_pairs.iter().filter(|p| p.floor.is_finite()) {
+                let d = model.links[pair.link]
+                    .posed(&frames)
+                    .distance(&model.links[pair.other].posed(&frames));
+                assert!(d >= pair.floor, "robot {r}: {d} below its floor {}", pair.floor);
+                tightest = tightest.min(d - pair.floor);
+            }
+        }
+        // A capsule arm may have no pair within two joints (no floor); the spheres have many.
+        assert!(
+            tightest < 0.05 || (r > 0 && tightest == Real::INFINITY),
+            "robot {r}: the floors are never approached ({tightest})"
+        );
+        if r == 0 {
+            let two = model.self_pairs.iter().filter(|p| p.joints.len() == 2);
+            let high = two.clone().filter(|p| p.floor > 0.05).count();
+            assert!(high * 4 > two.count(), "only {high} floors above 5 cm");
+        }
+    }
+}
+
+/// With the floors, clearance and every advancement are those of the plain check: the same
+/// value (a floor only leaves out pairs that could not lower it), and `advancement_within`
+/// the same answer, on random configurations and motions among a shelf's boards.
+#[test]
+fn floors_leave_clearance_and_advancement_unchanged() {
+    use crate::language::{Obstacle, Shape};
+    let board = |z: Real| Obstacle {
+        name: format!("board {z}"),
+        shape: Shape::Box {
+            center: v(0.55, 0.0, z),
+            size: v(0.3, 0.8, 0.02),
+            rotation: Rotation3::identity(),
+        },
+    };
+    let shelf = [board(0.2), board(0.6)];
+    let mut rng = rand::rngs::StdRng::seed_from_u64(31);
+    for (r, robot) in floor_robots().iter().enumerate() {
+        for scene in [CollisionScene::new(&[]), CollisionScene::new(&shelf)] {
+            let model = CollisionModel::new(robot, &scene);
+            let plain = without_floors(&model);
+            let (lower, upper) = (robot.lower(), robot.upper());
+            for k in 0..2000 {
+                let q = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+                let dq = JointVector::from_fn(|_, _| rng.random_range(-1.0..1.0))
+                    * rng.random_range(0.01..2.0);
+                let (fast, slow) = (clearance(&model, &q), clearance(&plain, &q));
+                assert!((fast - slow).abs() <= 1e-12, "robot {r}, {k}: {fast} vs {slow}");
+                let offset = [0.0, 0.01][k % 2];
+                let (fast, slow) =
+                    (advancement(&model, &q, &dq, offset), advancement(&plain, &q, &dq, offset));
+                assert!(fast <= slow + 1e-12 && (fast - slow).abs() <= 1e-12, "{fast} vs {slow}");
+                let (least, enough) = (rng.random_range(0.0..0.05), rng.random_range(0.05..1.0));
+                let fast = advancement_within(&model, &q, &dq, offset, least, enough);
+                let slow = advancement_within(&plain, &q, &dq, offset, least, enough);
+                assert_eq!(fast.is_some(), slow.is_some(), "robot {r}, {k}");
+                if let (Some(f), Some(s)) = (fast, slow) {
+                    assert!(f <= s + 1e-12 && (f - s).abs() <= 1e-12, "{f} vs {s}");
+                }
+            }
+        }
+    }
+}
+
+/// A pair's rate from the per-query table is never below its own dot product (so the table
+/// leaves out no pair the dot product keeps) and above it by rounding only.
+#[test]
+fn rate_table_bounds_every_pair_dot_product() {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(37);
+    for robot in floor_robots() {
+        let model = CollisionModel::new(&robot, &CollisionScene::new(&[]));
+        for _ in 0..200 {
+            let speed = JointVector::from_fn(|_, _| rng.random_range(0.0..3.0));
+            let rates = Rates::new(&model.links, &speed);
+            for (pair, hot) in model.self_pairs.iter().zip(&model.hot) {
+                assert_eq!(
+                    (pair.link, pair.other, pair.joints.start),
+                    (hot.link, hot.other, hot.start)
+                );
+                let (table, dot) = (rates.rate(hot.distal, hot.start), pair.levers.dot(&speed));
+                assert!(table >= dot && table <= dot * (1.0 + 1e-12), "{table} vs {dot}");
+            }
+        }
+    }
+}
