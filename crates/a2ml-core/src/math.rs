@@ -63,7 +63,12 @@ pub fn skew(v: &Vector3) -> Matrix3 {
 /// Wraps an angle into (-π, π].
 #[inline]
 pub fn wrap_angle(a: Real) -> Real {
-    let w = (a + PI).rem_euclid(2.0 * PI) - PI;
+    // `rem_euclid` of a value already in [0, 2π) is that value, bit for bit; IK wraps
+    // thousands of such angles per plan, and the remainder is a software `fmod`.
+    let shifted = a + PI;
+    let turned =
+        if (0.0..2.0 * PI).contains(&shifted) { shifted } else { shifted.rem_euclid(2.0 * PI) };
+    let w = turned - PI;
     if w <= -PI { w + 2.0 * PI } else { w }
 }
 
@@ -120,23 +125,68 @@ pub fn projector(n: &Vector3) -> Matrix3 {
 }
 
 /// The solutions θ in (-π, π] of `a cos θ + b sin θ = c` (none, one or two).
-pub fn solve_trig(a: Real, b: Real, c: Real) -> Vec<Real> {
+pub fn solve_trig(a: Real, b: Real, c: Real) -> Few<Real, 2> {
     // Coefficients here are lengths and products of arm dimensions: no overflow risk, and
     // sqrt is several times faster than hypot.
+    let mut roots = Few::new(0.0);
     let rho = (a * a + b * b).sqrt();
     if rho < 1e-14 {
-        return Vec::new();
+        return roots;
     }
     let ratio = c / rho;
     if ratio.abs() > 1.0 + 1e-12 {
-        return Vec::new();
+        return roots;
     }
     let phi = b.atan2(a);
     let delta = ratio.clamp(-1.0, 1.0).acos();
     if delta < 1e-12 {
-        vec![wrap_angle(phi)]
+        roots.push(wrap_angle(phi));
     } else {
-        vec![wrap_angle(phi + delta), wrap_angle(phi - delta)]
+        roots.push(wrap_angle(phi + delta));
+        roots.push(wrap_angle(phi - delta));
+    }
+    roots
+}
+
+/// At most `N` values, kept inline: IK finds a few roots and placements per call, and a
+/// heap allocation for each was a measurable share of a call. Reads as a slice.
+#[derive(Debug, Clone, Copy)]
+pub struct Few<T: Copy, const N: usize> {
+    items: [T; N],
+    len: usize,
+}
+
+impl<T: Copy, const N: usize> Few<T, N> {
+    /// None yet; `fill` only occupies the unused places.
+    pub const fn new(fill: T) -> Self {
+        Self { items: [fill; N], len: 0 }
+    }
+
+    /// Appends `value`.
+    ///
+    /// # Panics
+    /// When `N` values are already there: the callers push at most `N` by construction
+    /// (roots of one trigonometric equation, one placement per root).
+    pub fn push(&mut self, value: T) {
+        self.items[self.len] = value;
+        self.len += 1;
+    }
+}
+
+impl<T: Copy, const N: usize> std::ops::Deref for Few<T, N> {
+    type Target = [T];
+
+    fn deref(&self) -> &[T] {
+        &self.items[..self.len]
+    }
+}
+
+impl<T: Copy, const N: usize> IntoIterator for Few<T, N> {
+    type Item = T;
+    type IntoIter = std::iter::Take<std::array::IntoIter<T, N>>;
+
+    fn into_iter(self) -> Self::IntoIter {
+        self.items.into_iter().take(self.len)
     }
 }
 
@@ -220,5 +270,32 @@ mod tests {
             }
         }
         assert!(solve_trig(1.0, 0.0, 2.0).is_empty());
+    }
+
+    #[test]
+    fn wrap_angle_fast_path_keeps_the_bits_of_the_remainder() {
+        // In [0, 2π) after the shift, the remainder is the value itself: the fast path must
+        // give what the remainder gives, bit for bit, on both sides of every boundary.
+        let general = |a: Real| {
+            let w = (a + PI).rem_euclid(2.0 * PI) - PI;
+            if w <= -PI { w + 2.0 * PI } else { w }
+        };
+        let mut a: Real = -7.0;
+        while a < 7.0 {
+            for x in [a, -PI, PI, PI.next_down(), (-PI).next_up(), 0.0, -0.0] {
+                assert_eq!(wrap_angle(x).to_bits(), general(x).to_bits(), "{x}");
+            }
+            a += 1e-3;
+        }
+    }
+
+    #[test]
+    fn few_reads_as_the_values_pushed() {
+        let mut few: Few<Real, 2> = Few::new(0.0);
+        assert!(few.is_empty());
+        few.push(1.5);
+        few.push(-2.0);
+        assert_eq!(&few[..], &[1.5, -2.0]);
+        assert_eq!(few.into_iter().collect::<Vec<_>>(), vec![1.5, -2.0]);
     }
 }

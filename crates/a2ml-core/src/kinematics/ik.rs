@@ -19,7 +19,7 @@ use super::spaces::{
     hat_state,
 };
 use crate::math::{
-    DOF, JointVector, Matrix3, Matrix7, PI, Real, Rotation3, Vector3, Vector7, reject,
+    DOF, Few, JointVector, Matrix3, Matrix7, PI, Real, Rotation3, Vector3, Vector7, reject,
     rotation_about, rotation_log, solve_trig, wrap_angle,
 };
 use crate::robot::{ArmStructure, Robot};
@@ -389,7 +389,7 @@ pub(crate) fn triangle_placements(
     wrist_zero: &Vector3,
     elbow: &Vector3,
     wrist: &Vector3,
-) -> Result<Vec<(Real, Matrix3)>, KinematicsError> {
+) -> Result<Few<(Real, Matrix3), 2>, KinematicsError> {
     placements_of(&robot.structure, wrist_zero, elbow, wrist)
 }
 
@@ -399,7 +399,7 @@ fn placements_of(
     wrist_zero: &Vector3,
     elbow: &Vector3,
     wrist: &Vector3,
-) -> Result<Vec<(Real, Matrix3)>, KinematicsError> {
+) -> Result<Few<(Real, Matrix3), 2>, KinematicsError> {
     let (w, p) = (&s.axes_zero, &s.axis_points_zero);
     let d = wrist.norm();
 
@@ -422,15 +422,15 @@ fn placements_of(
             max: lu + lf,
         });
     }
-    q4s.into_iter()
-        .map(|q4| {
-            let (s4, c4) = q4.sin_cos();
-            let wrist_moved = c0 + c4 * v_perp + s4 * w_perp;
-            align(&s.elbow_zero, &wrist_moved, elbow, wrist)
-                .map(|r123| (q4, r123))
-                .ok_or(KinematicsError::Singular(Singularity::StraightArm))
-        })
-        .collect()
+    let mut placements = Few::new((0.0, Matrix3::zeros()));
+    for q4 in q4s {
+        let (s4, c4) = q4.sin_cos();
+        let wrist_moved = c0 + c4 * v_perp + s4 * w_perp;
+        let r123 = align(&s.elbow_zero, &wrist_moved, elbow, wrist)
+            .ok_or(KinematicsError::Singular(Singularity::StraightArm))?;
+        placements.push((q4, r123));
+    }
+    Ok(placements)
 }
 
 /// [`analytic_branches`] for a wrist centre that sits at `wrist_zero` when
@@ -541,7 +541,8 @@ fn nearest_branch(
     let placements = placements_of(s, &s.wrist_zero, elbow, wrist)?;
     // No branch of an elbow angle is nearer than its q4 is to near's (2π shifts included).
     let bound = |q4: Real| wrap_angle(q4 - near[3]).abs() - 1e-9;
-    let mut order: Vec<usize> = (0..placements.len()).collect();
+    let mut order = [0, 1];
+    let order = &mut order[..placements.len()];
     if let [(a, _), (b, _)] = placements[..] {
         if wrap_angle(a - b).abs() <= 1e-6 {
             return Ok(None);
@@ -564,7 +565,7 @@ fn nearest_branch(
     let mut best: Option<Candidate> = None;
     let mut branches = Vec::with_capacity(8);
     let mut kept: Vec<JointVector> = Vec::with_capacity(8);
-    for g in order {
+    for &mut g in order {
         let (q4, r123) = placements[g];
         if best.is_some_and(|(d, ..)| bound(q4) > d) {
             continue;
@@ -644,7 +645,10 @@ fn push_shifts(robot: &Robot, q: JointVector, out: &mut Vec<JointVector>) {
     out.push(q);
     for (i, joint) in robot.joints.iter().enumerate() {
         let l = &joint.limits;
-        let base = q[i] - 2.0 * PI * ((q[i] - l.lower) / (2.0 * PI)).floor();
+        // Most angles are within a turn above the lower limit, where the floor is 0 and the
+        // shift leaves them as they are (bit for bit); `floor` is a library call here.
+        let turns = (q[i] - l.lower) / (2.0 * PI);
+        let base = if (0.0..1.0).contains(&turns) { q[i] } else { q[i] - 2.0 * PI * turns.floor() };
         // base is the smallest shift at or above the lower limit.
         let shift = |k: u32| base + 2.0 * PI * Real::from(k);
         let inside = (0..).take_while(|k| shift(*k) <= l.upper + 1e-9).count() as u32;

@@ -15,7 +15,7 @@ use super::error::KinematicsError;
 use super::ik::{decompose, triangle_placements};
 use super::spaces::{CpsaState, cpsa_to_hat, hat_points};
 use crate::math::{
-    Matrix3, PI, Real, Rotation3, Vector3, projector, rotation_about, skew, solve_trig,
+    Few, Matrix3, PI, Real, Rotation3, Vector3, projector, rotation_about, skew, solve_trig,
 };
 use crate::robot::Robot;
 
@@ -57,7 +57,7 @@ impl TrigMatrix {
     }
 
     /// The θ where `uᵀ R(θ) v = k`.
-    fn roots(&self, u: &Vector3, v: &Vector3, k: Real) -> Vec<Real> {
+    fn roots(&self, u: &Vector3, v: &Vector3, k: Real) -> Few<Real, 2> {
         let f = |m: &Matrix3| u.dot(&(m * v));
         solve_trig(f(&self.a), f(&self.b), k - f(&self.c))
     }
