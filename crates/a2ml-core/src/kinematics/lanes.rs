@@ -37,7 +37,7 @@ type LaneMatrix = [[Lane; 3]; 3];
 #[derive(Debug, Clone, Copy)]
 struct Step {
     rotation: Constant,
-    translation: [Real; 3],
+    translation: Offset,
 }
 
 /// A constant rotation of the chain. Most joint frames of the shipped arms are turned by 0 or
@@ -100,6 +100,33 @@ fn snapped(t: [Real; 3]) -> [Real; 3] {
     t.map(|v| if v.abs() <= SNAP * size { 0.0 } else { v })
 }
 
+/// A constant offset of the chain by its nonzero components (the shipped arms' offsets mostly
+/// lie along one axis of their frame), so that [`apply`] multiplies only those, in a branch
+/// chosen once per joint and group rather than a loop over the components.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Offset {
+    Zero,
+    /// Component `.0` of value `.1`, the others 0.
+    One(usize, Real),
+    /// Two components (index, value), in index order, the third 0.
+    Two([(usize, Real); 2]),
+    /// Every component nonzero.
+    Three([Real; 3]),
+}
+
+impl Offset {
+    fn of(v: [Real; 3]) -> Self {
+        let nonzero: Vec<(usize, Real)> =
+            v.iter().copied().enumerate().filter(|(_, value)| *value != 0.0).collect();
+        match nonzero[..] {
+            [] => Self::Zero,
+            [(r, value)] => Self::One(r, value),
+            [a, b] => Self::Two([a, b]),
+            _ => Self::Three(v),
+        }
+    }
+}
+
 /// The robot's chain prepared for [`LANES`] configurations at a time.
 ///
 /// Batched results pair rows as `Iterator::zip` does: `q` holds rows of 7 joint values
@@ -108,9 +135,9 @@ fn snapped(t: [Real; 3]) -> [Real; 3] {
 pub struct BatchedChain {
     steps: [Step; DOF],
     /// E in aligned frame 3.
-    elbow: [Real; 3],
+    elbow: Offset,
     /// W in aligned frame 6.
-    wrist: [Real; 3],
+    wrist: Offset,
     /// Ow from aligned frame 7: the hand's rotation in that frame.
     hand: Constant,
 }
@@ -149,21 +176,21 @@ fn values_of(v: &Vector3) -> [Real; 3] {
 impl BatchedChain {
     /// The chain of `robot`.
     pub fn new(robot: &Robot) -> Self {
-        Self::from_constants(robot, Constant::of, snapped)
+        Self::from_constants(robot, Constant::of, |t| Offset::of(snapped(t)))
     }
 
     /// The chain of `robot` with every constant a [`Constant::General`] product and no
     /// component skipped: the slow exact kernel the specialised one is tested against.
     #[cfg(test)]
     fn general(robot: &Robot) -> Self {
-        Self::from_constants(robot, |c| Constant::General(*c), |t| t)
+        Self::from_constants(robot, |c| Constant::General(*c), Offset::Three)
     }
 
     /// The chain, its rotations taken by `rotation` and its offsets by `offset`.
     fn from_constants(
         robot: &Robot,
         rotation: impl Fn(&[[Real; 3]; 3]) -> Constant,
-        offset: impl Fn([Real; 3]) -> [Real; 3],
+        offset: impl Fn([Real; 3]) -> Offset,
     ) -> Self {
         let align: [Matrix3; DOF] = std::array::from_fn(|k| aligning(&robot.joints[k].axis));
         // A_{k-1}ᵀ for frame k, the identity for {b}.
@@ -222,11 +249,20 @@ impl BatchedChain {
         mut states: impl FnMut(usize, Result<CpsaState, KinematicsError>),
     ) {
         let rows = q.len() / DOF;
+        let mut swivel = [None; LANES];
         self.each_group::<false, _>(q, 0..rows, |pose, lane, row| {
+            // A group's lanes come in order from 0: its angles are computed at its first.
+            if lane == 0 {
+                swivel = swivels(&pose.elbow, &pose.wrist, &robot.vertical);
+            }
             let point = |v: &LaneVector| Vector3::new(v[0][lane], v[1][lane], v[2][lane]);
             let hand = Matrix3::from_fn(|i, j| pose.hand[i][j][lane]);
             let hand = Rotation3::from_matrix_unchecked(hand);
-            states(row, cpsa_from_points(robot, &point(&pose.elbow), &point(&pose.wrist), hand));
+            let state = match swivel[lane] {
+                Some(swivel) => Ok(CpsaState { pw: point(&pose.wrist), ow: hand, swivel }),
+                None => cpsa_from_points(robot, &point(&pose.elbow), &point(&pose.wrist), hand),
+            };
+            states(row, state);
         });
     }
 
@@ -309,16 +345,15 @@ impl BatchedChain {
         let (mut elbow, mut wrist) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3]);
         for (k, step) in self.steps.iter().enumerate() {
             translation = apply(&rotation, &step.translation, &translation);
-            let m = step.rotation.times(&rotation);
             let (sin, cos) = sin_cos(&joints[k]);
-            for i in 0..3 {
-                let (x, y) = (&m[i][0], &m[i][1]);
-                for l in 0..LANES {
-                    rotation[i][0][l] = x[l] * cos[l] + y[l] * sin[l];
-                    rotation[i][1][l] = y[l] * cos[l] - x[l] * sin[l];
+            rotation = match &step.rotation {
+                Constant::Permutation { source, sign } => {
+                    turned_permutation(&rotation, source, sign, &sin, &cos)
                 }
-                rotation[i][2] = m[i][2];
-                axes[k][i] = m[i][2];
+                Constant::General(c) => turned(&times_constant(&rotation, c), &sin, &cos),
+            };
+            for i in 0..3 {
+                axes[k][i] = rotation[i][2];
             }
             axis_points[k] = translation;
             // E rides on frame 3, W on frame 6.
@@ -344,6 +379,97 @@ impl BatchedChain {
     }
 }
 
+/// Below this sine of the elbow angle, or distance (m) of W from the vertical through S, a
+/// lane is left to [`cpsa_from_points`], which decides the singularity by its own tolerances
+/// (1e-9, a thousand times smaller): near them, rounding could tip the decision.
+const REGULAR: Real = 1e-6;
+
+#[inline(always)]
+fn norm(v: &[Real; 3]) -> Real {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+#[inline(always)]
+fn cross(a: &[Real; 3], b: &[Real; 3]) -> [Real; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+#[inline(always)]
+fn dot(a: &[Real; 3], b: &[Real; 3]) -> Real {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// θsw of each lane, side by side, as [`cpsa_from_points`] computes it (the triangle S = 0,
+/// E, W: l the unit normal of its plane, n that of the vertical plane through W, θsw =
+/// atan2(-(n × l)·x, n·l) with x along W); `None` for a lane near a singularity.
+#[inline(always)]
+fn swivels(elbow: &LaneVector, wrist: &LaneVector, vertical: &Vector3) -> [Option<Real>; LANES] {
+    let vertical = values_of(vertical);
+    let (mut a, mut b, mut regular) = ([0.0; LANES], [0.0; LANES], [false; LANES]);
+    for l in 0..LANES {
+        let e = [elbow[0][l], elbow[1][l], elbow[2][l]];
+        let w = [wrist[0][l], wrist[1][l], wrist[2][l]];
+        let ew = [w[0] - e[0], w[1] - e[1], w[2] - e[2]];
+        let (upper, fore) = (norm(&e), norm(&ew));
+        let r = e.map(|v| v / upper);
+        let u = ew.map(|v| v / fore);
+        let v = cross(&u, &r);
+        let plane = norm(&v);
+        let normal = v.map(|c| c / plane);
+        let m = cross(&vertical, &w);
+        let m_norm = norm(&m);
+        let n = m.map(|c| c / m_norm);
+        let length = norm(&w);
+        let x = w.map(|c| c / length);
+        a[l] = -dot(&cross(&n, &normal), &x);
+        b[l] = dot(&n, &normal);
+        // Written so that a NaN is not regular.
+        regular[l] = plane >= REGULAR && m_norm >= REGULAR;
+    }
+    std::array::from_fn(|l| regular[l].then(|| a[l].atan2(b[l])))
+}
+
+/// `m` turned about its z column by the angle of (sin, cos) in each lane: `m Rz(θ)`.
+#[inline(always)]
+fn turned(m: &LaneMatrix, sin: &Lane, cos: &Lane) -> LaneMatrix {
+    let mut out = *m;
+    for i in 0..3 {
+        let (x, y) = (&m[i][0], &m[i][1]);
+        for l in 0..LANES {
+            out[i][0][l] = x[l] * cos[l] + y[l] * sin[l];
+            out[i][1][l] = y[l] * cos[l] - x[l] * sin[l];
+        }
+    }
+    out
+}
+
+/// [`turned`] of `m c` for a signed permutation c (column j of `m c` is `sign[j]` times column
+/// `source[j]` of m), without forming `m c`: the signs go onto the sine and cosine instead
+/// of onto 36 entries. A product by ±1 is exact and rounding is symmetric in sign, so
+/// `(±x) cos = x (±cos)` to the bit: the same values as `turned(&c.times(m), ..)`.
+#[inline(always)]
+fn turned_permutation(
+    m: &LaneMatrix,
+    source: &[usize; 3],
+    sign: &[Real; 3],
+    sin: &Lane,
+    cos: &Lane,
+) -> LaneMatrix {
+    let signed = |v: &Lane, s: Real| v.map(|x| x * s);
+    let (cos_x, sin_x) = (signed(cos, sign[0]), signed(sin, sign[0]));
+    let (cos_y, sin_y) = (signed(cos, sign[1]), signed(sin, sign[1]));
+    let mut out = [[[0.0; LANES]; 3]; 3];
+    for i in 0..3 {
+        let (x, y, z) = (&m[i][source[0]], &m[i][source[1]], &m[i][source[2]]);
+        for l in 0..LANES {
+            out[i][0][l] = x[l] * cos_x[l] + y[l] * sin_y[l];
+            out[i][1][l] = y[l] * cos_y[l] - x[l] * sin_x[l];
+            out[i][2][l] = z[l] * sign[2];
+        }
+    }
+    out
+}
+
 /// `m c` with c the same in every lane.
 #[inline(always)]
 fn times_constant(m: &LaneMatrix, c: &[[Real; 3]; 3]) -> LaneMatrix {
@@ -358,20 +484,38 @@ fn times_constant(m: &LaneMatrix, c: &[[Real; 3]; 3]) -> LaneMatrix {
     out
 }
 
-/// `m v + t` with v the same in every lane, its zero components skipped (the shipped arms'
-/// offsets mostly lie along one axis): with m finite a skipped term is ±0, which changes no
-/// sum but the sign of a zero.
+/// `m v + t` with v the same in every lane, its zero components skipped: with m finite a
+/// skipped term is ±0, which changes no sum but the sign of a zero. The terms are summed in
+/// index order, then added to t.
 #[inline(always)]
-fn apply(m: &LaneMatrix, v: &[Real; 3], t: &LaneVector) -> LaneVector {
-    let mut sum = [[0.0; LANES]; 3];
-    for (r, &value) in v.iter().enumerate().filter(|(_, value)| **value != 0.0) {
-        for i in 0..3 {
-            for l in 0..LANES {
-                sum[i][l] += m[i][r][l] * value;
+fn apply(m: &LaneMatrix, v: &Offset, t: &LaneVector) -> LaneVector {
+    let mut out = *t;
+    // The match outside the loops, so that each arm is a straight run of lane products.
+    match *v {
+        Offset::Zero => {}
+        Offset::One(r, a) => {
+            for i in 0..3 {
+                for l in 0..LANES {
+                    out[i][l] += m[i][r][l] * a;
+                }
+            }
+        }
+        Offset::Two([(r, a), (s, b)]) => {
+            for i in 0..3 {
+                for l in 0..LANES {
+                    out[i][l] += m[i][r][l] * a + m[i][s][l] * b;
+                }
+            }
+        }
+        Offset::Three([a, b, c]) => {
+            for i in 0..3 {
+                for l in 0..LANES {
+                    out[i][l] += m[i][0][l] * a + m[i][1][l] * b + m[i][2][l] * c;
+                }
             }
         }
     }
-    std::array::from_fn(|i| std::array::from_fn(|l| t[i][l] + sum[i][l]))
+    out
 }
 
 /// Lane `lane`'s hand frame {W} as a row-major 4x4 homogeneous matrix.
@@ -654,6 +798,41 @@ mod tests {
         assert_eq!(Constant::of(&twice), Constant::General(twice));
         assert_eq!(snapped([6e-17, 0.2, -3e-16]), [0.0, 0.2, 0.0]);
         assert_eq!(snapped([1e-3, 0.0, 0.0]), [1e-3, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn offsets_keep_their_nonzero_components_in_order() {
+        assert_eq!(Offset::of([0.0, 0.0, 0.0]), Offset::Zero);
+        assert_eq!(Offset::of([0.0, -0.2, 0.0]), Offset::One(1, -0.2));
+        assert_eq!(Offset::of([0.1, 0.0, 0.3]), Offset::Two([(0, 0.1), (2, 0.3)]));
+        assert_eq!(Offset::of([0.1, 0.2, 0.3]), Offset::Three([0.1, 0.2, 0.3]));
+    }
+
+    /// The signs folded into the sine and cosine give the bits of the product formed first.
+    #[test]
+    fn a_turned_permutation_gives_the_bits_of_the_formed_product() {
+        let mut state: u64 = 7;
+        let mut value = || {
+            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (state >> 11) as Real / (1u64 << 53) as Real - 0.5
+        };
+        let m: LaneMatrix =
+            std::array::from_fn(|_| std::array::from_fn(|_| [(); LANES].map(|_| value())));
+        let angles = [(); LANES].map(|_| 8.0 * value());
+        let (sin, cos) = sin_cos(&angles);
+        for (source, sign) in [
+            ([0, 1, 2], [1.0, 1.0, 1.0]),
+            ([2, 0, 1], [-1.0, 1.0, -1.0]),
+            ([1, 2, 0], [1.0, -1.0, -1.0]),
+        ] {
+            let c = Constant::Permutation { source, sign };
+            let expected = turned(&c.times(&m), &sin, &cos);
+            let got = turned_permutation(&m, &source, &sign, &sin, &cos);
+            let bits = |m: &LaneMatrix| {
+                m.as_flattened().as_flattened().iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+            };
+            assert_eq!(bits(&got), bits(&expected), "{source:?} {sign:?}");
+        }
     }
 
     /// The specialised products against the full ones: the same values (a zero's sign aside)
