@@ -140,6 +140,8 @@ pub struct BatchedChain {
     wrist: Offset,
     /// Ow from aligned frame 7: the hand's rotation in that frame.
     hand: Constant,
+    /// The robot's vertical z_b, for the swivel angle.
+    vertical: Vector3,
 }
 
 /// What forward kinematics gives for one group of lanes, in {b}.
@@ -152,6 +154,8 @@ struct GroupPose {
     wrist: LaneVector,
     /// Ow.
     hand: LaneMatrix,
+    /// θsw where asked for and regular (see [`swivels`]).
+    swivel: [Option<Real>; LANES],
 }
 
 /// A rotation whose z column is `axis`, its x and y from a cross product with the basis
@@ -210,19 +214,22 @@ impl BatchedChain {
             elbow: offset(values_of(&(aligned_from_frame(3) * s.elbow_in_frame3))),
             wrist: offset(values_of(&(aligned_from_frame(6) * s.wrist_in_frame6))),
             hand: rotation(&rows_of(&(aligned_from_frame(DOF) * robot.frame7_from_hand.matrix()))),
+            vertical: robot.vertical,
         }
     }
 
     /// The hand frame {W} (row-major 4x4: Ow and W) at each row of `q`.
     pub fn hand_frames(&self, q: &[Real], frames: &mut [Real]) {
         let rows = frames.chunks_exact_mut(FRAME_VALUES);
-        self.each_group::<false, _>(q, rows, |pose, lane, frame| write_frame(frame, pose, lane));
+        self.each_group::<false, false, _>(q, rows, |pose, lane, frame| {
+            write_frame(frame, pose, lane)
+        });
     }
 
     /// J_ge (row-major 6x7, as [`super::geometric_jacobian`]) at each row of `q`.
     pub fn jacobians(&self, q: &[Real], jacobians: &mut [Real]) {
         let rows = jacobians.chunks_exact_mut(JACOBIAN_VALUES);
-        self.each_group::<true, _>(q, rows, |pose, lane, j| write_jacobian(j, pose, lane));
+        self.each_group::<true, false, _>(q, rows, |pose, lane, j| write_jacobian(j, pose, lane));
     }
 
     /// The hand frame and J_ge at each row of `q`, from one forward kinematics.
@@ -234,7 +241,7 @@ impl BatchedChain {
     ) {
         let rows =
             frames.chunks_exact_mut(FRAME_VALUES).zip(jacobians.chunks_exact_mut(JACOBIAN_VALUES));
-        self.each_group::<true, _>(q, rows, |pose, lane, (frame, j)| {
+        self.each_group::<true, false, _>(q, rows, |pose, lane, (frame, j)| {
             write_frame(frame, pose, lane);
             write_jacobian(j, pose, lane);
         });
@@ -249,16 +256,11 @@ impl BatchedChain {
         mut states: impl FnMut(usize, Result<CpsaState, KinematicsError>),
     ) {
         let rows = q.len() / DOF;
-        let mut swivel = [None; LANES];
-        self.each_group::<false, _>(q, 0..rows, |pose, lane, row| {
-            // A group's lanes come in order from 0: its angles are computed at its first.
-            if lane == 0 {
-                swivel = swivels(&pose.elbow, &pose.wrist, &robot.vertical);
-            }
+        self.each_group::<false, true, _>(q, 0..rows, |pose, lane, row| {
             let point = |v: &LaneVector| Vector3::new(v[0][lane], v[1][lane], v[2][lane]);
             let hand = Matrix3::from_fn(|i, j| pose.hand[i][j][lane]);
             let hand = Rotation3::from_matrix_unchecked(hand);
-            let state = match swivel[lane] {
+            let state = match pose.swivel[lane] {
                 Some(swivel) => Ok(CpsaState { pw: point(&pose.wrist), ow: hand, swivel }),
                 None => cpsa_from_points(robot, &point(&pose.elbow), &point(&pose.wrist), hand),
             };
@@ -272,9 +274,10 @@ impl BatchedChain {
     /// On x86_64 processors with AVX2 the loop runs as a copy compiled for them (four lanes
     /// to an instruction instead of two); both copies do the same operations in the same
     /// order (Rust never fuses a multiply and an add on its own), so the bits are the same.
-    /// `LINEAR`: whether the pose needs J_ge's linear rows (left zero otherwise).
+    /// `LINEAR`: whether the pose needs J_ge's linear rows (left zero otherwise); `SWIVEL`:
+    /// whether it needs the swivel angles (else `None`).
     #[inline(always)]
-    fn each_group<const LINEAR: bool, O>(
+    fn each_group<const LINEAR: bool, const SWIVEL: bool, O>(
         &self,
         q: &[Real],
         outputs: impl IntoIterator<Item = O>,
@@ -285,27 +288,27 @@ impl BatchedChain {
             // SAFETY: the processor has AVX2, checked on the line above.
             #[allow(unsafe_code)]
             unsafe {
-                return self.each_group_avx2::<LINEAR, O>(q, outputs, each);
+                return self.each_group_avx2::<LINEAR, SWIVEL, O>(q, outputs, each);
             }
         }
-        self.each_group_portable::<LINEAR, O>(q, outputs, each);
+        self.each_group_portable::<LINEAR, SWIVEL, O>(q, outputs, each);
     }
 
     /// [`Self::each_group`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn each_group_avx2<const LINEAR: bool, O>(
+    fn each_group_avx2<const LINEAR: bool, const SWIVEL: bool, O>(
         &self,
         q: &[Real],
         outputs: impl IntoIterator<Item = O>,
         each: impl FnMut(&GroupPose, usize, O),
     ) {
-        self.each_group_portable::<LINEAR, O>(q, outputs, each);
+        self.each_group_portable::<LINEAR, SWIVEL, O>(q, outputs, each);
     }
 
     /// [`Self::each_group`] for any processor; inlined into the AVX2 copy.
     #[inline(always)]
-    fn each_group_portable<const LINEAR: bool, O>(
+    fn each_group_portable<const LINEAR: bool, const SWIVEL: bool, O>(
         &self,
         q: &[Real],
         outputs: impl IntoIterator<Item = O>,
@@ -323,7 +326,7 @@ impl BatchedChain {
                     joints[k][l] = group[DOF * lane + k];
                 }
             }
-            let pose = self.group_pose::<LINEAR>(&joints);
+            let pose = self.group_pose::<LINEAR, SWIVEL>(&joints);
             for lane in 0..rows {
                 let Some(out) = outputs.next() else { return };
                 each(&pose, lane, out);
@@ -334,7 +337,10 @@ impl BatchedChain {
     /// Forward kinematics of one group: `joints[k]` holds joint k's value in each lane; J_ge's
     /// linear rows only when `LINEAR` (the frames and CPSA states do not read them).
     #[inline(always)]
-    fn group_pose<const LINEAR: bool>(&self, joints: &[Lane; DOF]) -> GroupPose {
+    fn group_pose<const LINEAR: bool, const SWIVEL: bool>(
+        &self,
+        joints: &[Lane; DOF],
+    ) -> GroupPose {
         let mut rotation: LaneMatrix = [[[0.0; LANES]; 3]; 3];
         for (i, row) in rotation.iter_mut().enumerate() {
             row[i] = [1.0; LANES];
@@ -375,7 +381,8 @@ impl BatchedChain {
                 linear[k][2][l] = z[0][l] * d[1] - z[1][l] * d[0];
             }
         }
-        GroupPose { axes, linear, elbow, wrist, hand: self.hand.times(&rotation) }
+        let swivel = if SWIVEL { swivels(&elbow, &wrist, &self.vertical) } else { [None; LANES] };
+        GroupPose { axes, linear, elbow, wrist, hand: self.hand.times(&rotation), swivel }
     }
 }
 
@@ -455,12 +462,32 @@ fn turned_permutation(
     sin: &Lane,
     cos: &Lane,
 ) -> LaneMatrix {
+    // One copy per permutation, its columns known at compile time, so that the rotation can
+    // stay in registers instead of being indexed in memory.
+    match *source {
+        [0, 1, 2] => turned_columns::<0, 1, 2>(m, sign, sin, cos),
+        [0, 2, 1] => turned_columns::<0, 2, 1>(m, sign, sin, cos),
+        [1, 0, 2] => turned_columns::<1, 0, 2>(m, sign, sin, cos),
+        [1, 2, 0] => turned_columns::<1, 2, 0>(m, sign, sin, cos),
+        [2, 0, 1] => turned_columns::<2, 0, 1>(m, sign, sin, cos),
+        _ => turned_columns::<2, 1, 0>(m, sign, sin, cos),
+    }
+}
+
+/// [`turned_permutation`] for the permutation (X, Y, Z).
+#[inline(always)]
+fn turned_columns<const X: usize, const Y: usize, const Z: usize>(
+    m: &LaneMatrix,
+    sign: &[Real; 3],
+    sin: &Lane,
+    cos: &Lane,
+) -> LaneMatrix {
     let signed = |v: &Lane, s: Real| v.map(|x| x * s);
     let (cos_x, sin_x) = (signed(cos, sign[0]), signed(sin, sign[0]));
     let (cos_y, sin_y) = (signed(cos, sign[1]), signed(sin, sign[1]));
     let mut out = [[[0.0; LANES]; 3]; 3];
     for i in 0..3 {
-        let (x, y, z) = (&m[i][source[0]], &m[i][source[1]], &m[i][source[2]]);
+        let (x, y, z) = (&m[i][X], &m[i][Y], &m[i][Z]);
         for l in 0..LANES {
             out[i][0][l] = x[l] * cos_x[l] + y[l] * sin_y[l];
             out[i][1][l] = y[l] * cos_y[l] - x[l] * sin_x[l];
@@ -770,7 +797,7 @@ mod tests {
             let rows = portable_frames
                 .chunks_exact_mut(FRAME_VALUES)
                 .zip(portable_jacobians.chunks_exact_mut(JACOBIAN_VALUES));
-            chain.each_group_portable::<true, _>(&q, rows, |pose, lane, (frame, j)| {
+            chain.each_group_portable::<true, false, _>(&q, rows, |pose, lane, (frame, j)| {
                 write_frame(frame, pose, lane);
                 write_jacobian(j, pose, lane);
             });
@@ -820,11 +847,9 @@ mod tests {
             std::array::from_fn(|_| std::array::from_fn(|_| [(); LANES].map(|_| value())));
         let angles = [(); LANES].map(|_| 8.0 * value());
         let (sin, cos) = sin_cos(&angles);
-        for (source, sign) in [
-            ([0, 1, 2], [1.0, 1.0, 1.0]),
-            ([2, 0, 1], [-1.0, 1.0, -1.0]),
-            ([1, 2, 0], [1.0, -1.0, -1.0]),
-        ] {
+        let permutations = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+        let signs = [[1.0, 1.0, 1.0], [-1.0, 1.0, -1.0], [1.0, -1.0, -1.0]];
+        for (source, sign) in permutations.into_iter().flat_map(|p| signs.map(|s| (p, s))) {
             let c = Constant::Permutation { source, sign };
             let expected = turned(&c.times(&m), &sin, &cos);
             let got = turned_permutation(&m, &source, &sign, &sin, &cos);
