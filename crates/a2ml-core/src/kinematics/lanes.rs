@@ -5,7 +5,8 @@
 //!
 //! The chain is taken in aligned frames (each joint's axis turned onto z, as
 //! [`super::AlignedChain`] does), so a joint costs one constant rotation product and a
-//! two-column turn. Sines and cosines are computed per lane by the polynomials of fdlibm's
+//! two-column turn; where the constant is a signed permutation (most joints of the shipped
+//! arms) the product is only a choice of columns, its signs put on the sine and cosine. Sines and cosines are computed per lane by the polynomials of fdlibm's
 //! kernels (within an ulp or two of the platform's), the angle reduced by a two-part π/2.
 //! Lanes never mix: a configuration's result does not depend on the others in its group, so
 //! any split of a batch gives the same bits.
