@@ -5,7 +5,8 @@
 //!
 //! The chain is taken in aligned frames (each joint's axis turned onto z, as
 //! [`super::AlignedChain`] does), so a joint costs one constant rotation product and a
-//! two-column turn. Sines and cosines are computed per lane by the polynomials of fdlibm's
+//! two-column turn; where the constant is a signed permutation (most joints of the shipped
+//! arms) the product is only a choice of columns, its signs put on the sine and cosine. Sines and cosines are computed per lane by the polynomials of fdlibm's
 //! kernels (within an ulp or two of the platform's), the angle reduced by a two-part π/2.
 //! Lanes never mix: a configuration's result does not depend on the others in its group, so
 //! any split of a batch gives the same bits.
@@ -37,7 +38,7 @@ type LaneMatrix = [[Lane; 3]; 3];
 #[derive(Debug, Clone, Copy)]
 struct Step {
     rotation: Constant,
-    translation: [Real; 3],
+    translation: Offset,
 }
 
 /// A constant rotation of the chain. Most joint frames of the shipped arms are turned by 0 or
@@ -100,6 +101,33 @@ fn snapped(t: [Real; 3]) -> [Real; 3] {
     t.map(|v| if v.abs() <= SNAP * size { 0.0 } else { v })
 }
 
+/// A constant offset of the chain by its nonzero components (the shipped arms' offsets mostly
+/// lie along one axis of their frame), so that [`apply`] multiplies only those, in a branch
+/// chosen once per joint and group rather than a loop over the components.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Offset {
+    Zero,
+    /// Component `.0` of value `.1`, the others 0.
+    One(usize, Real),
+    /// Two components (index, value), in index order, the third 0.
+    Two([(usize, Real); 2]),
+    /// Every component nonzero.
+    Three([Real; 3]),
+}
+
+impl Offset {
+    fn of(v: [Real; 3]) -> Self {
+        let nonzero: Vec<(usize, Real)> =
+            v.iter().copied().enumerate().filter(|(_, value)| *value != 0.0).collect();
+        match nonzero[..] {
+            [] => Self::Zero,
+            [(r, value)] => Self::One(r, value),
+            [a, b] => Self::Two([a, b]),
+            _ => Self::Three(v),
+        }
+    }
+}
+
 /// The robot's chain prepared for [`LANES`] configurations at a time.
 ///
 /// Batched results pair rows as `Iterator::zip` does: `q` holds rows of 7 joint values
@@ -108,11 +136,13 @@ fn snapped(t: [Real; 3]) -> [Real; 3] {
 pub struct BatchedChain {
     steps: [Step; DOF],
     /// E in aligned frame 3.
-    elbow: [Real; 3],
+    elbow: Offset,
     /// W in aligned frame 6.
-    wrist: [Real; 3],
+    wrist: Offset,
     /// Ow from aligned frame 7: the hand's rotation in that frame.
     hand: Constant,
+    /// The robot's vertical z_b, for the swivel angle.
+    vertical: Vector3,
 }
 
 /// What forward kinematics gives for one group of lanes, in {b}.
@@ -125,6 +155,8 @@ struct GroupPose {
     wrist: LaneVector,
     /// Ow.
     hand: LaneMatrix,
+    /// θsw where asked for and regular (see [`swivels`]).
+    swivel: [Option<Real>; LANES],
 }
 
 /// A rotation whose z column is `axis`, its x and y from a cross product with the basis
@@ -149,21 +181,21 @@ fn values_of(v: &Vector3) -> [Real; 3] {
 impl BatchedChain {
     /// The chain of `robot`.
     pub fn new(robot: &Robot) -> Self {
-        Self::from_constants(robot, Constant::of, snapped)
+        Self::from_constants(robot, Constant::of, |t| Offset::of(snapped(t)))
     }
 
     /// The chain of `robot` with every constant a [`Constant::General`] product and no
     /// component skipped: the slow exact kernel the specialised one is tested against.
     #[cfg(test)]
     fn general(robot: &Robot) -> Self {
-        Self::from_constants(robot, |c| Constant::General(*c), |t| t)
+        Self::from_constants(robot, |c| Constant::General(*c), Offset::Three)
     }
 
     /// The chain, its rotations taken by `rotation` and its offsets by `offset`.
     fn from_constants(
         robot: &Robot,
         rotation: impl Fn(&[[Real; 3]; 3]) -> Constant,
-        offset: impl Fn([Real; 3]) -> [Real; 3],
+        offset: impl Fn([Real; 3]) -> Offset,
     ) -> Self {
         let align: [Matrix3; DOF] = std::array::from_fn(|k| aligning(&robot.joints[k].axis));
         // A_{k-1}ᵀ for frame k, the identity for {b}.
@@ -183,19 +215,22 @@ impl BatchedChain {
             elbow: offset(values_of(&(aligned_from_frame(3) * s.elbow_in_frame3))),
             wrist: offset(values_of(&(aligned_from_frame(6) * s.wrist_in_frame6))),
             hand: rotation(&rows_of(&(aligned_from_frame(DOF) * robot.frame7_from_hand.matrix()))),
+            vertical: robot.vertical,
         }
     }
 
     /// The hand frame {W} (row-major 4x4: Ow and W) at each row of `q`.
     pub fn hand_frames(&self, q: &[Real], frames: &mut [Real]) {
         let rows = frames.chunks_exact_mut(FRAME_VALUES);
-        self.each_group::<false, _>(q, rows, |pose, lane, frame| write_frame(frame, pose, lane));
+        self.each_group::<false, false, _>(q, rows, |pose, lane, frame| {
+            write_frame(frame, pose, lane)
+        });
     }
 
     /// J_ge (row-major 6x7, as [`super::geometric_jacobian`]) at each row of `q`.
     pub fn jacobians(&self, q: &[Real], jacobians: &mut [Real]) {
         let rows = jacobians.chunks_exact_mut(JACOBIAN_VALUES);
-        self.each_group::<true, _>(q, rows, |pose, lane, j| write_jacobian(j, pose, lane));
+        self.each_group::<true, false, _>(q, rows, |pose, lane, j| write_jacobian(j, pose, lane));
     }
 
     /// The hand frame and J_ge at each row of `q`, from one forward kinematics.
@@ -207,7 +242,7 @@ impl BatchedChain {
     ) {
         let rows =
             frames.chunks_exact_mut(FRAME_VALUES).zip(jacobians.chunks_exact_mut(JACOBIAN_VALUES));
-        self.each_group::<true, _>(q, rows, |pose, lane, (frame, j)| {
+        self.each_group::<true, false, _>(q, rows, |pose, lane, (frame, j)| {
             write_frame(frame, pose, lane);
             write_jacobian(j, pose, lane);
         });
@@ -222,11 +257,15 @@ impl BatchedChain {
         mut states: impl FnMut(usize, Result<CpsaState, KinematicsError>),
     ) {
         let rows = q.len() / DOF;
-        self.each_group::<false, _>(q, 0..rows, |pose, lane, row| {
+        self.each_group::<false, true, _>(q, 0..rows, |pose, lane, row| {
             let point = |v: &LaneVector| Vector3::new(v[0][lane], v[1][lane], v[2][lane]);
             let hand = Matrix3::from_fn(|i, j| pose.hand[i][j][lane]);
             let hand = Rotation3::from_matrix_unchecked(hand);
-            states(row, cpsa_from_points(robot, &point(&pose.elbow), &point(&pose.wrist), hand));
+            let state = match pose.swivel[lane] {
+                Some(swivel) => Ok(CpsaState { pw: point(&pose.wrist), ow: hand, swivel }),
+                None => cpsa_from_points(robot, &point(&pose.elbow), &point(&pose.wrist), hand),
+            };
+            states(row, state);
         });
     }
 
@@ -236,9 +275,10 @@ impl BatchedChain {
     /// On x86_64 processors with AVX2 the loop runs as a copy compiled for them (four lanes
     /// to an instruction instead of two); both copies do the same operations in the same
     /// order (Rust never fuses a multiply and an add on its own), so the bits are the same.
-    /// `LINEAR`: whether the pose needs J_ge's linear rows (left zero otherwise).
+    /// `LINEAR`: whether the pose needs J_ge's linear rows (left zero otherwise); `SWIVEL`:
+    /// whether it needs the swivel angles (else `None`).
     #[inline(always)]
-    fn each_group<const LINEAR: bool, O>(
+    fn each_group<const LINEAR: bool, const SWIVEL: bool, O>(
         &self,
         q: &[Real],
         outputs: impl IntoIterator<Item = O>,
@@ -249,27 +289,27 @@ impl BatchedChain {
             // SAFETY: the processor has AVX2, checked on the line above.
             #[allow(unsafe_code)]
             unsafe {
-                return self.each_group_avx2::<LINEAR, O>(q, outputs, each);
+                return self.each_group_avx2::<LINEAR, SWIVEL, O>(q, outputs, each);
             }
         }
-        self.each_group_portable::<LINEAR, O>(q, outputs, each);
+        self.each_group_portable::<LINEAR, SWIVEL, O>(q, outputs, each);
     }
 
     /// [`Self::each_group`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn each_group_avx2<const LINEAR: bool, O>(
+    fn each_group_avx2<const LINEAR: bool, const SWIVEL: bool, O>(
         &self,
         q: &[Real],
         outputs: impl IntoIterator<Item = O>,
         each: impl FnMut(&GroupPose, usize, O),
     ) {
-        self.each_group_portable::<LINEAR, O>(q, outputs, each);
+        self.each_group_portable::<LINEAR, SWIVEL, O>(q, outputs, each);
     }
 
     /// [`Self::each_group`] for any processor; inlined into the AVX2 copy.
     #[inline(always)]
-    fn each_group_portable<const LINEAR: bool, O>(
+    fn each_group_portable<const LINEAR: bool, const SWIVEL: bool, O>(
         &self,
         q: &[Real],
         outputs: impl IntoIterator<Item = O>,
@@ -287,7 +327,7 @@ impl BatchedChain {
                     joints[k][l] = group[DOF * lane + k];
                 }
             }
-            let pose = self.group_pose::<LINEAR>(&joints);
+            let pose = self.group_pose::<LINEAR, SWIVEL>(&joints);
             for lane in 0..rows {
                 let Some(out) = outputs.next() else { return };
                 each(&pose, lane, out);
@@ -298,7 +338,10 @@ impl BatchedChain {
     /// Forward kinematics of one group: `joints[k]` holds joint k's value in each lane; J_ge's
     /// linear rows only when `LINEAR` (the frames and CPSA states do not read them).
     #[inline(always)]
-    fn group_pose<const LINEAR: bool>(&self, joints: &[Lane; DOF]) -> GroupPose {
+    fn group_pose<const LINEAR: bool, const SWIVEL: bool>(
+        &self,
+        joints: &[Lane; DOF],
+    ) -> GroupPose {
         let mut rotation: LaneMatrix = [[[0.0; LANES]; 3]; 3];
         for (i, row) in rotation.iter_mut().enumerate() {
             row[i] = [1.0; LANES];
@@ -309,16 +352,15 @@ impl BatchedChain {
         let (mut elbow, mut wrist) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3]);
         for (k, step) in self.steps.iter().enumerate() {
             translation = apply(&rotation, &step.translation, &translation);
-            let m = step.rotation.times(&rotation);
             let (sin, cos) = sin_cos(&joints[k]);
-            for i in 0..3 {
-                let (x, y) = (&m[i][0], &m[i][1]);
-                for l in 0..LANES {
-                    rotation[i][0][l] = x[l] * cos[l] + y[l] * sin[l];
-                    rotation[i][1][l] = y[l] * cos[l] - x[l] * sin[l];
+            rotation = match &step.rotation {
+                Constant::Permutation { source, sign } => {
+                    turned_permutation(&rotation, source, sign, &sin, &cos)
                 }
-                rotation[i][2] = m[i][2];
-                axes[k][i] = m[i][2];
+                Constant::General(c) => turned(&times_constant(&rotation, c), &sin, &cos),
+            };
+            for i in 0..3 {
+                axes[k][i] = rotation[i][2];
             }
             axis_points[k] = translation;
             // E rides on frame 3, W on frame 6.
@@ -340,8 +382,120 @@ impl BatchedChain {
                 linear[k][2][l] = z[0][l] * d[1] - z[1][l] * d[0];
             }
         }
-        GroupPose { axes, linear, elbow, wrist, hand: self.hand.times(&rotation) }
+        let swivel = if SWIVEL { swivels(&elbow, &wrist, &self.vertical) } else { [None; LANES] };
+        GroupPose { axes, linear, elbow, wrist, hand: self.hand.times(&rotation), swivel }
     }
+}
+
+/// Below this sine of the elbow angle, or distance (m) of W from the vertical through S, a
+/// lane is left to [`cpsa_from_points`], which decides the singularity by its own tolerances
+/// (1e-9, a thousand times smaller): near them, rounding could tip the decision.
+const REGULAR: Real = 1e-6;
+
+#[inline(always)]
+fn norm(v: &[Real; 3]) -> Real {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+#[inline(always)]
+fn cross(a: &[Real; 3], b: &[Real; 3]) -> [Real; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+#[inline(always)]
+fn dot(a: &[Real; 3], b: &[Real; 3]) -> Real {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// θsw of each lane, side by side, as [`cpsa_from_points`] computes it (the triangle S = 0,
+/// E, W: l the unit normal of its plane, n that of the vertical plane through W, θsw =
+/// atan2(-(n × l)·x, n·l) with x along W); `None` for a lane near a singularity.
+#[inline(always)]
+fn swivels(elbow: &LaneVector, wrist: &LaneVector, vertical: &Vector3) -> [Option<Real>; LANES] {
+    let vertical = values_of(vertical);
+    let (mut a, mut b, mut regular) = ([0.0; LANES], [0.0; LANES], [false; LANES]);
+    for l in 0..LANES {
+        let e = [elbow[0][l], elbow[1][l], elbow[2][l]];
+        let w = [wrist[0][l], wrist[1][l], wrist[2][l]];
+        let ew = [w[0] - e[0], w[1] - e[1], w[2] - e[2]];
+        let (upper, fore) = (norm(&e), norm(&ew));
+        let r = e.map(|v| v / upper);
+        let u = ew.map(|v| v / fore);
+        let v = cross(&u, &r);
+        let plane = norm(&v);
+        let normal = v.map(|c| c / plane);
+        let m = cross(&vertical, &w);
+        let m_norm = norm(&m);
+        let n = m.map(|c| c / m_norm);
+        let length = norm(&w);
+        let x = w.map(|c| c / length);
+        a[l] = -dot(&cross(&n, &normal), &x);
+        b[l] = dot(&n, &normal);
+        // Written so that a NaN is not regular.
+        regular[l] = plane >= REGULAR && m_norm >= REGULAR;
+    }
+    std::array::from_fn(|l| regular[l].then(|| a[l].atan2(b[l])))
+}
+
+/// `m` turned about its z column by the angle of (sin, cos) in each lane: `m Rz(θ)`.
+#[inline(always)]
+fn turned(m: &LaneMatrix, sin: &Lane, cos: &Lane) -> LaneMatrix {
+    let mut out = *m;
+    for i in 0..3 {
+        let (x, y) = (&m[i][0], &m[i][1]);
+        for l in 0..LANES {
+            out[i][0][l] = x[l] * cos[l] + y[l] * sin[l];
+            out[i][1][l] = y[l] * cos[l] - x[l] * sin[l];
+        }
+    }
+    out
+}
+
+/// [`turned`] of `m c` for a signed permutation c (column j of `m c` is `sign[j]` times column
+/// `source[j]` of m), without forming `m c`: the signs go onto the sine and cosine instead
+/// of onto 36 entries. A product by ±1 is exact and rounding is symmetric in sign, so
+/// `(±x) cos = x (±cos)` to the bit: the same values as `turned(&c.times(m), ..)`.
+#[inline(always)]
+fn turned_permutation(
+    m: &LaneMatrix,
+    source: &[usize; 3],
+    sign: &[Real; 3],
+    sin: &Lane,
+    cos: &Lane,
+) -> LaneMatrix {
+    // One copy per permutation, its columns known at compile time, so that the rotation can
+    // stay in registers instead of being indexed in memory.
+    match *source {
+        [0, 1, 2] => turned_columns::<0, 1, 2>(m, sign, sin, cos),
+        [0, 2, 1] => turned_columns::<0, 2, 1>(m, sign, sin, cos),
+        [1, 0, 2] => turned_columns::<1, 0, 2>(m, sign, sin, cos),
+        [1, 2, 0] => turned_columns::<1, 2, 0>(m, sign, sin, cos),
+        [2, 0, 1] => turned_columns::<2, 0, 1>(m, sign, sin, cos),
+        _ => turned_columns::<2, 1, 0>(m, sign, sin, cos),
+    }
+}
+
+/// [`turned_permutation`] for the permutation (X, Y, Z).
+#[inline(always)]
+fn turned_columns<const X: usize, const Y: usize, const Z: usize>(
+    m: &LaneMatrix,
+    sign: &[Real; 3],
+    sin: &Lane,
+    cos: &Lane,
+) -> LaneMatrix {
+    let signed = |v: &Lane, s: Real| v.map(|x| x * s);
+    let (cos_x, sin_x) = (signed(cos, sign[0]), signed(sin, sign[0]));
+    let (cos_y, sin_y) = (signed(cos, sign[1]), signed(sin, sign[1]));
+    let mut out = [[[0.0; LANES]; 3]; 3];
+    for i in 0..3 {
+        let (x, y, z) = (&m[i][X], &m[i][Y], &m[i][Z]);
+        for l in 0..LANES {
+            out[i][0][l] = x[l] * cos_x[l] + y[l] * sin_y[l];
+            out[i][1][l] = y[l] * cos_y[l] - x[l] * sin_x[l];
+            out[i][2][l] = z[l] * sign[2];
+        }
+    }
+    out
 }
 
 /// `m c` with c the same in every lane.
@@ -358,20 +512,38 @@ fn times_constant(m: &LaneMatrix, c: &[[Real; 3]; 3]) -> LaneMatrix {
     out
 }
 
-/// `m v + t` with v the same in every lane, its zero components skipped (the shipped arms'
-/// offsets mostly lie along one axis): with m finite a skipped term is ±0, which changes no
-/// sum but the sign of a zero.
+/// `m v + t` with v the same in every lane, its zero components skipped: with m finite a
+/// skipped term is ±0, which changes no sum but the sign of a zero. The terms are summed in
+/// index order, then added to t.
 #[inline(always)]
-fn apply(m: &LaneMatrix, v: &[Real; 3], t: &LaneVector) -> LaneVector {
-    let mut sum = [[0.0; LANES]; 3];
-    for (r, &value) in v.iter().enumerate().filter(|(_, value)| **value != 0.0) {
-        for i in 0..3 {
-            for l in 0..LANES {
-                sum[i][l] += m[i][r][l] * value;
+fn apply(m: &LaneMatrix, v: &Offset, t: &LaneVector) -> LaneVector {
+    let mut out = *t;
+    // The match outside the loops, so that each arm is a straight run of lane products.
+    match *v {
+        Offset::Zero => {}
+        Offset::One(r, a) => {
+            for i in 0..3 {
+                for l in 0..LANES {
+                    out[i][l] += m[i][r][l] * a;
+                }
+            }
+        }
+        Offset::Two([(r, a), (s, b)]) => {
+            for i in 0..3 {
+                for l in 0..LANES {
+                    out[i][l] += m[i][r][l] * a + m[i][s][l] * b;
+                }
+            }
+        }
+        Offset::Three([a, b, c]) => {
+            for i in 0..3 {
+                for l in 0..LANES {
+                    out[i][l] += m[i][0][l] * a + m[i][1][l] * b + m[i][2][l] * c;
+                }
             }
         }
     }
-    std::array::from_fn(|i| std::array::from_fn(|l| t[i][l] + sum[i][l]))
+    out
 }
 
 /// Lane `lane`'s hand frame {W} as a row-major 4x4 homogeneous matrix.
@@ -626,7 +798,7 @@ mod tests {
             let rows = portable_frames
                 .chunks_exact_mut(FRAME_VALUES)
                 .zip(portable_jacobians.chunks_exact_mut(JACOBIAN_VALUES));
-            chain.each_group_portable::<true, _>(&q, rows, |pose, lane, (frame, j)| {
+            chain.each_group_portable::<true, false, _>(&q, rows, |pose, lane, (frame, j)| {
                 write_frame(frame, pose, lane);
                 write_jacobian(j, pose, lane);
             });
@@ -654,6 +826,39 @@ mod tests {
         assert_eq!(Constant::of(&twice), Constant::General(twice));
         assert_eq!(snapped([6e-17, 0.2, -3e-16]), [0.0, 0.2, 0.0]);
         assert_eq!(snapped([1e-3, 0.0, 0.0]), [1e-3, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn offsets_keep_their_nonzero_components_in_order() {
+        assert_eq!(Offset::of([0.0, 0.0, 0.0]), Offset::Zero);
+        assert_eq!(Offset::of([0.0, -0.2, 0.0]), Offset::One(1, -0.2));
+        assert_eq!(Offset::of([0.1, 0.0, 0.3]), Offset::Two([(0, 0.1), (2, 0.3)]));
+        assert_eq!(Offset::of([0.1, 0.2, 0.3]), Offset::Three([0.1, 0.2, 0.3]));
+    }
+
+    /// The signs folded into the sine and cosine give the bits of the product formed first.
+    #[test]
+    fn a_turned_permutation_gives_the_bits_of_the_formed_product() {
+        let mut state: u64 = 7;
+        let mut value = || {
+            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (state >> 11) as Real / (1u64 << 53) as Real - 0.5
+        };
+        let m: LaneMatrix =
+            std::array::from_fn(|_| std::array::from_fn(|_| [(); LANES].map(|_| value())));
+        let angles = [(); LANES].map(|_| 8.0 * value());
+        let (sin, cos) = sin_cos(&angles);
+        let permutations = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+        let signs = [[1.0, 1.0, 1.0], [-1.0, 1.0, -1.0], [1.0, -1.0, -1.0]];
+        for (source, sign) in permutations.into_iter().flat_map(|p| signs.map(|s| (p, s))) {
+            let c = Constant::Permutation { source, sign };
+            let expected = turned(&c.times(&m), &sin, &cos);
+            let got = turned_permutation(&m, &source, &sign, &sin, &cos);
+            let bits = |m: &LaneMatrix| {
+                m.as_flattened().as_flattened().iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+            };
+            assert_eq!(bits(&got), bits(&expected), "{source:?} {sign:?}");
+        }
     }
 
     /// The specialised products against the full ones: the same values (a zero's sign aside)
