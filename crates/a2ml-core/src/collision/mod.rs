@@ -25,8 +25,7 @@ mod model;
 
 pub use guard::{ShapeError, check_shapes};
 pub use model::{
-    CollisionModel, advancement, advancement_among, advancement_at_least, advancement_within,
-    clearance, motion_bound,
+    CollisionModel, advancement, advancement_at_least, advancement_within, clearance, motion_bound,
 };
 
 /// The task's obstacles as parry shapes, positioned in {b}.

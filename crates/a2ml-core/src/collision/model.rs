@@ -477,7 +477,7 @@ impl Arm {
 /// The smallest signed distance (m, negative for a penetration) over the pairs of
 /// [`super::min_distance`] with the arm at `q`; ∞ when there is no pair.
 pub fn clearance(model: &CollisionModel, q: &JointVector) -> Real {
-    model.smallest(q, 0.0, None, (Real::NEG_INFINITY, Real::INFINITY), None, None)
+    model.smallest(q, 0.0, None, Real::NEG_INFINITY, Real::INFINITY)
 }
 
 /// How far the arm at `q` can move along the straight joint-space motion `dq`, either way,
@@ -498,7 +498,7 @@ pub fn advancement(
     dq: &JointVector,
     clearance: Real,
 ) -> Real {
-    model.smallest(q, clearance, Some(&dq.abs()), (Real::NEG_INFINITY, Real::INFINITY), None, None)
+    model.smallest(q, clearance, Some(&dq.abs()), Real::NEG_INFINITY, Real::INFINITY)
 }
 
 /// [`advancement`] if it is at least `least`, else `None`: a check that only needs to know
@@ -525,29 +525,7 @@ pub fn advancement_within(
     least: Real,
     enough: Real,
 ) -> Option<Real> {
-    let found = model.smallest(q, clearance, Some(&dq.abs()), (least, enough), None, None);
-    (found >= least).then_some(found)
-}
-
-/// [`advancement_within`] over the `units` (ascending; all when `None`) an earlier check left
-/// unsettled, writing to `unsettled` (after clearing it) the units this check does not settle:
-/// a unit is a group of the arm's capsules against every obstacle, or the self pairs of two
-/// groups, and it is settled where its bounding spheres or floors show that none of its pairs
-/// can come within `clearance` over a motion of `enough` either way. A unit settled over a
-/// stretch of an edge need not be asked again inside it: a check there may read only the
-/// rest, for the same guarantee at a fraction of the cost.
-pub fn advancement_among(
-    model: &CollisionModel,
-    q: &JointVector,
-    dq: &JointVector,
-    clearance: Real,
-    (least, enough): (Real, Real),
-    units: Option<&[u32]>,
-    unsettled: &mut Vec<u32>,
-) -> Option<Real> {
-    unsettled.clear();
-    let found =
-        model.smallest(q, clearance, Some(&dq.abs()), (least, enough), units, Some(unsettled));
+    let found = model.smallest(q, clearance, Some(&dq.abs()), least, enough);
     (found >= least).then_some(found)
 }
 
@@ -562,36 +540,15 @@ impl CollisionModel {
     /// The smallest `reach(d − offset)` over the pairs, at most `enough`, d the signed
     /// distance of a pair and `reach` the advancement its [`Motion`] along `speed` (|dq|)
     /// allows; with no motion, the smallest d − offset. Stops below `least`.
-    ///
-    /// `units`: only these [`CollisionModel::units`] (ascending), or all; `unsettled`, if
-    /// given, receives (ascending) every unit looked at that is not shown to allow `enough`
-    /// by its bounding spheres or floors (incomplete when the answer is below `least`).
     fn smallest(
         &self,
         q: &JointVector,
         offset: Real,
         speed: Option<&JointVector>,
-        (least, enough): (Real, Real),
-        units: Option<&[u32]>,
-        mut unsettled: Option<&mut Vec<u32>>,
+        least: Real,
+        enough: Real,
     ) -> Real {
         let frames = self.arm.chain.frames(q);
-        // Units are visited in ascending order: a cursor in the list tells which to look at.
-        let mut cursor = 0;
-        let mut selected = |unit: u32| match units {
-            None => true,
-            Some(list) => {
-                while cursor < list.len() && list[cursor] < unit {
-                    cursor += 1;
-                }
-                list.get(cursor) == Some(&unit)
-            }
-        };
-        let mut keep = |unit: u32, settled: bool| {
-            if let (Some(out), false) = (unsettled.as_deref_mut(), settled) {
-                out.push(unit);
-            }
-        };
         // The configuration-independent motion bound first: cheap, and never below the
         // configuration's own, so it tells which pairs cannot lower `best`; the
         // configuration's own only for the nearest obstacle of a capsule that may.
@@ -601,18 +558,12 @@ impl CollisionModel {
             speed.map_or(Motion::UNIT, |speed| Motion::new(&frames, link, levers, speed, joints))
         };
         let mut best = enough;
-        for (g, group) in self.arm.groups.iter().enumerate() {
-            let unit = g as u32;
-            if !selected(unit) {
-                continue;
-            }
+        for group in &self.arm.groups {
             let frame = &frames[group.frame];
             let center = frame.apply(&group.center);
             // Obstacles whose distance from the group's bounding sphere is this or more
-            // cannot lower `best` through any member; at `far` or more, nor `enough`.
+            // cannot lower `best` through any member.
             let near = offset + loose(&group.levers).threshold(best);
-            let far = offset + loose(&group.levers).threshold(enough);
-            let mut settled = true;
             let n = group.members.len();
             let mut posed: [Option<Posed>; GROUP_SIZE] = Default::default();
             // Per member: only distances (between its segment and an obstacle's core) below
@@ -629,9 +580,7 @@ impl CollisionModel {
             // Members are placed when an obstacle first comes near the group.
             let place = |m: usize| self.arm.links[group.members[m]].posed(&frames);
             for sphere in &self.spheres {
-                let gap = (center - sphere.center).norm() - group.bound - sphere.radius;
-                settled &= gap >= far;
-                if gap >= near {
+                if (center - sphere.center).norm() - group.bound - sphere.radius >= near {
                     continue;
                 }
                 for m in 0..n {
@@ -652,7 +601,6 @@ impl CollisionModel {
                     - group.bound
                     - 0.5 * (capsule.b - capsule.a).norm()
                     - capsule.radius;
-                settled &= gap >= far;
                 if gap >= near {
                     continue;
                 }
@@ -673,13 +621,9 @@ impl CollisionModel {
                 let body = &convex.body;
                 // The bounding spheres first, then the solid's own distance from the group's
                 // centre: a long thin shelf's bounding sphere says little.
-                let gap = (center - body.center).norm() - group.bound - body.bound;
-                let solid = || convex.point_distance(&center) - group.bound;
-                if gap >= far || solid() >= far {
-                    continue;
-                }
-                settled = false;
-                if gap >= near || solid() >= near {
+                if (center - body.center).norm() - group.bound - body.bound >= near
+                    || convex.point_distance(&center) - group.bound >= near
+                {
                     continue;
                 }
                 for m in 0..n {
@@ -705,7 +649,6 @@ impl CollisionModel {
                     }
                 }
             }
-            keep(unit, settled);
             for m in 0..n {
                 if !found[m] {
                     continue;
@@ -729,12 +672,7 @@ impl CollisionModel {
         let bounding = |group: usize| {
             self.arm.groups.get(group).map(|g| (frames[g.frame].apply(&g.center), g.bound))
         };
-        let groups = self.arm.groups.len() as u32;
-        for (p, group_pair) in self.arm.group_pairs.iter().enumerate() {
-            let unit = groups + p as u32;
-            if !selected(unit) {
-                continue;
-            }
+        for group_pair in &self.arm.group_pairs {
             let loose_pair = loose(&group_pair.levers);
             // A pair whose floor is this high cannot lower `best`: its slack is at least the
             // floor's, and its own rate is at most the group pair's, which can only raise a
@@ -743,15 +681,15 @@ impl CollisionModel {
                 if best > 0.0 { loose_pair.threshold(best) + offset } else { Real::INFINITY }
             };
             let mut limit = floor_limit(best);
-            // The gap between the two groups' bounding spheres (none for a base capsule).
-            let spheres_gap = match (bounding(group_pair.groups.0), bounding(group_pair.groups.1)) {
-                (Some((ca, ba)), Some((cb, bb))) => Some((ca - cb).norm() - ba - bb - offset),
-                _ => None,
-            };
-            let apart = |s: Real| spheres_gap.is_some_and(|gap| gap >= loose_pair.threshold(s));
-            keep(unit, group_pair.floor >= floor_limit(enough) || apart(enough));
-            if group_pair.floor >= limit || apart(best) {
+            if group_pair.floor >= limit {
                 continue;
+            }
+            if let (Some((ca, ba)), Some((cb, bb))) =
+                (bounding(group_pair.groups.0), bounding(group_pair.groups.1))
+            {
+                if (ca - cb).norm() - ba - bb - offset >= loose_pair.threshold(best) {
+                    continue;
+                }
             }
             for (k, pair) in self.arm.hot[group_pair.pairs.clone()].iter().enumerate() {
                 // Sorted by floor: the rest are higher still.

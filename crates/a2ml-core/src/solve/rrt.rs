@@ -23,7 +23,7 @@ use super::monitor::Monitor;
 pub use super::timing::{LIMIT_FRACTION, TimedPath, shortest_bell, time_parameterise};
 use super::tree::{Tree, TreeSpace, connect_trees};
 use crate::collision::{
-    CollisionModel, CollisionScene, advancement_among, clearance, min_distance, motion_bound,
+    CollisionModel, CollisionScene, advancement_within, clearance, min_distance, motion_bound,
 };
 use crate::kinematics::arm_pose;
 use crate::math::{JointVector, Real};
@@ -286,14 +286,6 @@ struct JointSpace<'a> {
     model: CollisionModel,
     /// Uncovered stretches of the edge being checked (reused, to allocate once).
     gaps: Vec<Gap>,
-    /// The model's units each stretch must still check ([`advancement_among`]): ranges of
-    /// this, filled as checks leave units unsettled; and the last check's, and the other
-    /// end's (all reused).
-    units: Vec<u32>,
-    unsettled: Vec<u32>,
-    at_other_end: Vec<u32>,
-    /// Every check over every unit (tests compare the two).
-    plain: bool,
     checks: usize,
     /// When the search started, for its wall time.
     started: Instant,
@@ -308,8 +300,6 @@ struct Gap {
     to: Real,
     tight_a: bool,
     tight_b: bool,
-    /// The range of [`JointSpace::units`] not settled over a stretch containing this one.
-    units: (usize, usize),
 }
 
 impl<'a> JointSpace<'a> {
@@ -320,19 +310,7 @@ impl<'a> JointSpace<'a> {
         model: CollisionModel,
     ) -> Self {
         let started = Instant::now();
-        Self {
-            robot,
-            scene,
-            options,
-            model,
-            gaps: Vec::new(),
-            units: Vec::new(),
-            unsettled: Vec::new(),
-            at_other_end: Vec::new(),
-            plain: false,
-            checks: 0,
-            started,
-        }
+        Self { robot, scene, options, model, gaps: Vec::new(), checks: 0, started }
     }
 
     /// Why `q` is not a valid end (within the limits, `clearance` from the scene), if it is not.
@@ -352,36 +330,16 @@ impl<'a> JointSpace<'a> {
     }
 
     /// How far (in units of `dq`, up to `enough`) the arm at `q` may move along `dq`, either
-    /// way, keeping the clearance, if at least `least`, over the model's units in the range
-    /// `units` of [`JointSpace::units`] (all for `None`); the units it leaves unsettled in
-    /// [`JointSpace::unsettled`].
+    /// way, keeping the clearance, if at least `least`.
     fn advancement(
         &mut self,
         q: &JointVector,
         dq: &JointVector,
         least: Real,
         enough: Real,
-        units: Option<(usize, usize)>,
     ) -> Option<Real> {
         self.checks += 1;
-        let units = units.filter(|_| !self.plain).map(|(from, to)| &self.units[from..to]);
-        let clearance = self.options.clearance;
-        advancement_among(
-            &self.model,
-            q,
-            dq,
-            clearance,
-            (least, enough),
-            units,
-            &mut self.unsettled,
-        )
-    }
-
-    /// Appends the units of the last check to [`JointSpace::units`], returning their range.
-    fn keep_unsettled(&mut self) -> (usize, usize) {
-        let from = self.units.len();
-        self.units.extend_from_slice(&self.unsettled);
-        (from, self.units.len())
+        advancement_within(&self.model, q, dq, self.options.clearance, least, enough)
     }
 
     /// Whether the straight edge a -> b keeps the clearance, `b` being a new configuration
@@ -394,11 +352,7 @@ impl<'a> JointSpace<'a> {
     /// stretch reaching an end that shows less (a start left near the clearance: such
     /// stretches are split finer until covered, down to a millionth of that). The ends must
     /// keep the clearance, a new `b` over half the resolution too, so that the edges leaving it
-    /// are not that fine. So the whole edge keeps `clearance`. A check inside a stretch asks
-    /// only the model's units (a group of capsules against the scene, two groups' self pairs)
-    /// that the checks around it left unsettled: a unit settled at a point is clear over the
-    /// whole stretch that point was to cover ([`advancement_among`]), so leaving it out keeps
-    /// the guarantee, and the decisions are those of asking every unit (tested).
+    /// are not that fine. So the whole edge keeps `clearance`.
     fn edge_free(&mut self, a: &JointVector, b: &JointVector, new: bool) -> bool {
         let dq = b - a;
         let travel = motion_bound(&self.model, &dq);
@@ -407,19 +361,12 @@ impl<'a> JointSpace<'a> {
         }
         // Half the resolution of arm motion, in units of the edge.
         let floor = 0.5 * self.options.resolution / travel;
-        let Some(at_b) = self.advancement(b, &dq, if new { floor } else { 0.0 }, 1.0, None) else {
+        let Some(at_b) = self.advancement(b, &dq, if new { floor } else { 0.0 }, 1.0) else {
             return false;
         };
-        std::mem::swap(&mut self.unsettled, &mut self.at_other_end);
-        let Some(at_a) = self.advancement(a, &dq, 0.0, 1.0, None) else {
+        let Some(at_a) = self.advancement(a, &dq, 0.0, 1.0) else {
             return false;
         };
-        // A unit settled at either end is clear over the whole edge: the stretch between
-        // checks only those settled at neither (both lists ascending).
-        let from_b = &self.at_other_end;
-        self.unsettled.retain(|u| from_b.binary_search(u).is_ok());
-        self.units.clear();
-        let units = self.keep_unsettled();
         // Next to a tight end, stretches are split until covered, down to this.
         let finest = floor * 1e-6;
         self.gaps.clear();
@@ -428,7 +375,6 @@ impl<'a> JointSpace<'a> {
             to: 1.0 - at_b,
             tight_a: at_a < floor,
             tight_b: at_b < floor,
-            units,
         });
         while let Some(gap) = self.gaps.pop() {
             if gap.from >= gap.to {
@@ -437,20 +383,16 @@ impl<'a> JointSpace<'a> {
             let (middle, half) = (0.5 * (gap.from + gap.to), 0.5 * (gap.to - gap.from));
             // Enough to close the stretch, or to split it.
             let splits = if (gap.tight_a || gap.tight_b) && half > finest { 0.0 } else { floor };
-            let at = a + dq * middle;
-            let Some(covered) = self.advancement(&at, &dq, half.min(splits), half, Some(gap.units))
+            let Some(covered) = self.advancement(&(a + dq * middle), &dq, half.min(splits), half)
             else {
                 return false;
             };
             if covered >= half {
                 continue;
             }
-            // The units settled here are clear over this whole stretch: the two parts left
-            // check only the others.
-            let units = self.keep_unsettled();
             // Towards b last: a stretch next to a tends to be checked first.
-            self.gaps.push(Gap { from: middle + covered, tight_a: false, units, ..gap });
-            self.gaps.push(Gap { to: middle - covered, tight_b: false, units, ..gap });
+            self.gaps.push(Gap { from: middle + covered, tight_a: false, ..gap });
+            self.gaps.push(Gap { to: middle - covered, tight_b: false, ..gap });
         }
         true
     }
@@ -541,86 +483,4 @@ fn shortcut(
 /// The length of a joint-space path (rad, Euclidean per edge).
 pub fn path_length(waypoints: &[JointVector]) -> Real {
     waypoints.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
-}
-
-#[cfg(test)]
-mod tests {
-    use rand::{RngExt, SeedableRng};
-
-    use super::*;
-    use crate::language::{Obstacle, Shape};
-    use crate::math::{Rotation3, Vector3};
-
-    /// A bookshelf of turned boards and a post before the Panda, as in MotionBenchMaker.
-    fn shelf() -> CollisionScene {
-        let board = |i: usize, z: Real| Obstacle {
-            name: format!("board {i}"),
-            shape: Shape::Box {
-                center: Vector3::new(0.6, 0.05, z),
-                size: Vector3::new(0.35, 0.9, 0.02),
-                rotation: Rotation3::from_euler_angles(0.0, 0.05, 0.3),
-            },
-        };
-        let mut obstacles: Vec<Obstacle> =
-            [-0.3, 0.0, 0.3, 0.6].iter().enumerate().map(|(i, &z)| board(i, z)).collect();
-        obstacles.push(Obstacle {
-            name: "post".to_owned(),
-            shape: Shape::Cylinder {
-                center: Vector3::new(0.3, -0.45, 0.0),
-                radius: 0.05,
-                height: 1.2,
-                rotation: Rotation3::identity(),
-            },
-        });
-        CollisionScene::new(&obstacles)
-    }
-
-    fn panda(path: &str) -> Robot {
-        let root = format!("{}/../..", env!("CARGO_MANIFEST_DIR"));
-        Robot::from_urdf_file(format!("{root}/{path}")).expect("robot loads")
-    }
-
-    /// Leaving out the units settled over a stretch gives the decisions of checking every
-    /// unit at every point, on random edges of the sphere and capsule Pandas among a shelf
-    /// (clear, blocked and grazing ones), at both clearances the benches use.
-    #[test]
-    fn settled_units_left_out_give_the_same_edge_decisions() {
-        let scene = shelf();
-        let mut rng = StdRng::seed_from_u64(43);
-        let mut accepted = [0, 0];
-        for path in ["tests/data/panda_spheres/panda_spheres.urdf", "robots/panda.urdf"] {
-            let robot = panda(path);
-            for clearance in [0.0, 0.01] {
-                let options = RrtOptions { clearance, ..RrtOptions::default() };
-                let mut fast =
-                    JointSpace::new(&robot, &scene, &options, CollisionModel::new(&robot, &scene));
-                let mut plain =
-                    JointSpace::new(&robot, &scene, &options, CollisionModel::new(&robot, &scene));
-                plain.plain = true;
-                let (lower, upper) = (robot.lower(), robot.upper());
-                for _ in 0..1000 {
-                    let a = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
-                    let toward = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
-                    let step = rng.random_range(0.05..2.0);
-                    let b = a + (toward - a) * (step / (toward - a).norm()).min(1.0);
-                    let new = rng.random_bool(0.5);
-                    let (f, p) = (fast.edge_free(&a, &b, new), plain.edge_free(&a, &b, new));
-                    assert_eq!(f, p, "{path} at {clearance} m: {a:?} -> {b:?}");
-                    accepted[f as usize] += 1;
-                    // Every fifth accepted edge re-checked at points 2 mm of arm motion apart.
-                    if f && accepted[1] % 5 == 0 {
-                        let travel = motion_bound(&fast.model, &(b - a));
-                        let count = (travel / 2e-3).ceil().max(1.0) as usize;
-                        for k in 0..=count {
-                            let q = a + (b - a) * (k as Real / count as Real);
-                            let d = crate::collision::clearance(&fast.model, &q);
-                            assert!(d >= clearance, "{path}: {d} m inside an accepted edge");
-                        }
-                    }
-                }
-            }
-        }
-        // Both kinds are among them, enough of each for the comparison to mean something.
-        assert!(accepted.iter().all(|&n| n > 500), "{accepted:?} rejected, accepted");
-    }
 }
