@@ -1,7 +1,7 @@
 //! The cost of one collision query on the MotionBenchMaker Panda scenes of tests/data/mbm, in
 //! both arm models (`robots/panda.urdf`: capsules with the hand and fingers; VAMP's 59
-//! spheres): `clearance` at a configuration, and the edge check's `advancement_within` along a
-//! full RRT step. Each measurement runs over the same 64 seeded in-limit configurations of
+//! spheres): building the model, `clearance` at a configuration, and the edge check's
+//! `advancement_within` along a full RRT step. Each measurement runs over the same 64 seeded in-limit configurations of
 //! the scene's first problem, so a figure is the mean over free and colliding ones alike.
 
 use std::hint::black_box;
@@ -45,7 +45,12 @@ fn collision(c: &mut Criterion) {
         let queries = queries(&robot, options.step);
         for name in mbm_problems::SCENES {
             let problem = mbm_problems::problems(name).swap_remove(0);
-            let model = CollisionModel::new(&robot, &CollisionScene::new(&problem.obstacles));
+            let scene = CollisionScene::new(&problem.obstacles);
+            // What every `rrt_connect` pays before its first query.
+            group.bench_function(format!("model/{model_name}/{name}"), |b| {
+                b.iter(|| black_box(CollisionModel::new(&robot, black_box(&scene))))
+            });
+            let model = CollisionModel::new(&robot, &scene);
             group.bench_function(format!("clearance/{model_name}/{name}_64"), |b| {
                 b.iter(|| {
                     for (q, _) in &queries {

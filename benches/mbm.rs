@@ -4,15 +4,16 @@
 //! 1 cm clearance and at VAMP's own criterion (0 m: touching is free). Per scene and model, the
 //! solve rate and median over its 100 problems with what a solved problem costs (samples, tree
 //! nodes, collision queries, time per query), then one criterion measurement over a fixed set
-//! of them. `cargo bench --bench mbm -- none` prints the table alone.
+//! of them. `cargo bench --bench mbm -- none` prints the table alone; with another filter only
+//! the rows whose `mbm/<model>/<scene>` name contains it are computed (`-- spheres@0mm`).
 
 use std::hint::black_box;
 use std::time::Instant;
 
 use a2ml::Robot;
-use a2ml::collision::CollisionScene;
+use a2ml::collision::{CollisionModel, CollisionScene};
 use a2ml::math::Real;
-use a2ml::solve::rrt::{RrtError, RrtOptions, RrtStats, rrt_connect};
+use a2ml::solve::rrt::{RrtError, RrtOptions, RrtStats, rrt_connect_with};
 use criterion::{Criterion, criterion_group, criterion_main};
 
 #[path = "../tests/it/mbm_problems.rs"]
@@ -65,13 +66,38 @@ fn report(model: &str, name: &str, total: usize, solved: &[(Real, RrtStats)], re
     );
 }
 
+/// Criterion's filter: the first argument that is neither a flag nor a flag's value (cargo
+/// passes `--bench` first).
+fn filter() -> Option<String> {
+    const VALUED: [&str; 6] = [
+        "--profile-time",
+        "--sample-size",
+        "--measurement-time",
+        "--warm-up-time",
+        "--save-baseline",
+        "--baseline",
+    ];
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    (0..args.len())
+        .find(|&i| !args[i].starts_with('-') && (i == 0 || !VALUED.contains(&args[i - 1].as_str())))
+        .map(|i| args[i].clone())
+}
+
 fn mbm(c: &mut Criterion) {
     let mut group = c.benchmark_group("mbm");
+    // Each row solves 100 problems: only those a filter asks for (all for `none` or none).
+    let wanted = |row: &str| filter().is_none_or(|f| f == "none" || row.contains(&f));
     for (model, urdf, clearance) in MODELS {
         let options = RrtOptions { clearance, ..RrtOptions::default() };
         let robot =
             Robot::from_urdf_file(format!("{}/{urdf}", env!("CARGO_MANIFEST_DIR"))).expect("robot");
+        // The arm's half of the collision model, once per robot (as VAMP's robot is compiled
+        // once): its build is timed on its own in benches/collision.rs.
+        let arm = CollisionModel::new(&robot, &CollisionScene::new(&[]));
         for name in mbm_problems::SCENES {
+            if !wanted(&format!("mbm/{model}/{name}")) {
+                continue;
+            }
             let problems: Vec<_> = mbm_problems::problems(name)
                 .into_iter()
                 .map(|p| (CollisionScene::new(&p.obstacles), p))
@@ -81,7 +107,7 @@ fn mbm(c: &mut Criterion) {
             let mut refused = Refused::default();
             for (scene, p) in &problems {
                 let started = Instant::now();
-                match rrt_connect(&robot, scene, &p.start, &p.goals, &options) {
+                match rrt_connect_with(&arm, &robot, scene, &p.start, &p.goals, &options) {
                     Ok(path) => {
                         solved.push((started.elapsed().as_secs_f64(), path.stats));
                         solvable.push((scene, p));
@@ -97,7 +123,14 @@ fn mbm(c: &mut Criterion) {
             group.bench_function(format!("{model}/{name}_10_problems"), |b| {
                 b.iter(|| {
                     for (scene, p) in &solvable {
-                        let _ = rrt_connect(&robot, scene, &p.start, &p.goals, black_box(&options));
+                        let _ = rrt_connect_with(
+                            &arm,
+                            &robot,
+                            scene,
+                            &p.start,
+                            &p.goals,
+                            black_box(&options),
+                        );
                     }
                 })
             });

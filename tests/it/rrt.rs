@@ -2,12 +2,14 @@
 //! motion between checks), limits, determinism per seed, and clear failures.
 
 use a2ml::Robot;
-use a2ml::collision::{CollisionScene, arm_capsules, min_distance};
+use a2ml::collision::{CollisionModel, CollisionScene, arm_capsules, min_distance};
 use a2ml::kinematics::arm_pose;
 use a2ml::language::{Obstacle, Shape};
 use a2ml::math::{JointVector, Real, Vector3};
 use a2ml::robot::LinkRole;
-use a2ml::solve::rrt::{RrtError, RrtOptions, RrtPath, rrt_connect, time_parameterise};
+use a2ml::solve::rrt::{
+    RrtError, RrtOptions, RrtPath, rrt_connect, rrt_connect_with, time_parameterise,
+};
 use a2ml::trajectory::{Limits, peaks};
 
 use crate::common;
@@ -74,6 +76,29 @@ fn the_caged_panda_finds_a_collision_free_path() {
         assert_collision_free(&robot, &scene, &path, options.clearance);
         assert!(path.stats.collision_checks > 0 && path.stats.nodes >= 2);
     }
+}
+
+/// An arm prepared once (in another scene) gives the very paths of `rrt_connect` in every
+/// scene, and is refused for another robot.
+#[test]
+fn a_prepared_arm_gives_the_same_paths() {
+    let robot = common::load("panda");
+    let arm = CollisionModel::new(&robot, &sphere_cage(0).2);
+    let options = RrtOptions::default();
+    for k in [1, 2, 3] {
+        let (start, goal, scene) = sphere_cage(k);
+        let fresh = rrt_connect(&robot, &scene, &start, &[goal], &options).expect("a path");
+        let prepared =
+            rrt_connect_with(&arm, &robot, &scene, &start, &[goal], &options).expect("a path");
+        assert_eq!(fresh.waypoints, prepared.waypoints);
+        assert_eq!(fresh.stats.collision_checks, prepared.stats.collision_checks);
+    }
+    let (start, goal, scene) = sphere_cage(1);
+    let other = common::load("iiwa14");
+    assert!(matches!(
+        rrt_connect_with(&arm, &other, &scene, &start, &[goal], &options),
+        Err(RrtError::InvalidOptions { .. })
+    ));
 }
 
 #[test]

@@ -3,6 +3,8 @@
 //! capsule–box/cylinder distances (the last settled by tangents of the convex distance along
 //! the segment), parry only for the depth of a segment inside a box or cylinder.
 
+use std::sync::Arc;
+
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query;
 use parry3d_f64::shape::Segment;
@@ -21,16 +23,24 @@ use crate::robot::{LinkRole, Robot};
 /// every obstacle, plus the robot's self-collision pairs ([`Robot::self_pairs`]).
 #[derive(Debug, Clone)]
 pub struct CollisionModel {
+    /// What depends on the robot alone, shared by its models in several scenes
+    /// ([`CollisionModel::with_scene`]).
+    arm: Arc<Arm>,
+    spheres: Vec<Sphere>,
+    capsules: Vec<Capsule>,
+    /// Boxes and cylinders: closed forms, parry for a segment's depth inside.
+    convex: Vec<Convex>,
+}
+
+/// The arm's capsules and self pairs, prepared once per robot.
+#[derive(Debug, Clone)]
+struct Arm {
     chain: AlignedChain,
     links: Vec<LinkCapsule>,
     /// The capsules that move, a few of one frame at a time, each group with its bounding
     /// sphere: the broadphase that keeps the cost of a check growing with the obstacles near
     /// the arm rather than with every capsule × obstacle.
     groups: Vec<Group>,
-    spheres: Vec<Sphere>,
-    capsules: Vec<Capsule>,
-    /// Boxes and cylinders: closed forms, parry for a segment's depth inside.
-    convex: Vec<Convex>,
     /// Sorted by the pair of groups, so that [`GroupPair`] ranges cover them.
     self_pairs: Vec<SelfPair>,
     /// `self_pairs`' fields the loop over all of them reads, in the same order.
@@ -276,6 +286,68 @@ struct Capsule {
 impl CollisionModel {
     /// Prepares `robot`'s capsules against `scene`.
     pub fn new(robot: &Robot, scene: &CollisionScene) -> Self {
+        Self::of(Arc::new(Arm::new(robot)), scene)
+    }
+
+    /// The same arm against `scene`: the arm's part (its capsules, self pairs and their floors,
+    /// the costlier half to prepare) is shared, not built again. For a planner that meets many
+    /// scenes with one robot.
+    pub fn with_scene(&self, scene: &CollisionScene) -> Self {
+        Self::of(Arc::clone(&self.arm), scene)
+    }
+
+    /// Whether this model was prepared for `robot`'s capsules and self pairs (not a proof: the
+    /// counts and each capsule's frame and radius are compared).
+    pub fn fits(&self, robot: &Robot) -> bool {
+        let arm = &*self.arm;
+        arm.links.len() == robot.capsules.len()
+            && arm.self_pairs.len() == robot.self_pairs.len()
+            && arm
+                .links
+                .iter()
+                .zip(&robot.capsules)
+                .all(|(l, c)| l.frame == c.frame && l.radius == c.radius)
+    }
+
+    fn of(arm: Arc<Arm>, scene: &CollisionScene) -> Self {
+        let (mut spheres, mut capsules, mut convex) = (Vec::new(), Vec::new(), Vec::new());
+        for body in &scene.bodies {
+            match body.shape {
+                Core::Ball(ball) => {
+                    let t = body.pose.translation;
+                    spheres
+                        .push(Sphere { center: Vector3::new(t.x, t.y, t.z), radius: ball.radius })
+                }
+                Core::Segment(s) => capsules.push(Capsule {
+                    a: Vector3::new(s.a.x, s.a.y, s.a.z),
+                    b: Vector3::new(s.b.x, s.b.y, s.b.z),
+                    radius: body.margin,
+                }),
+                Core::Cuboid(cuboid) => convex.push(Convex {
+                    body: body.clone(),
+                    rotation: rotation_of(&body.pose),
+                    solid: Solid::Cuboid { half: from_parry(cuboid.half_extents) },
+                }),
+                Core::Cylinder(cylinder) => {
+                    // parry's cylinder runs along its y; the closed form wants it along z.
+                    let z_to_y = Rotation3::from_axis_angle(&Vector3::x_axis(), -PI / 2.0);
+                    convex.push(Convex {
+                        body: body.clone(),
+                        rotation: rotation_of(&body.pose) * z_to_y.matrix(),
+                        solid: Solid::Cylinder {
+                            radius: cylinder.radius,
+                            half_height: cylinder.half_height,
+                        },
+                    })
+                }
+            }
+        }
+        Self { arm, spheres, capsules, convex }
+    }
+}
+
+impl Arm {
+    fn new(robot: &Robot) -> Self {
         let last = robot.capsules.iter().map(|c| c.frame).max().unwrap_or(0);
         let chain = AlignedChain::new(robot, last);
         let links: Vec<LinkCapsule> = robot
@@ -349,15 +421,27 @@ impl CollisionModel {
         for (pair, floor) in self_pairs.iter_mut().zip(floors) {
             pair.floor = floor;
         }
-        let group_of = |capsule: usize| groups.iter().position(|g| g.members.contains(&capsule));
+        // Looked up once per capsule: the sort below asks for it at every comparison.
+        let mut groups_of: Vec<Option<usize>> = vec![None; links.len()];
+        for (g, group) in groups.iter().enumerate() {
+            for &i in &group.members {
+                groups_of[i] = Some(g);
+            }
+        }
+        let group_of = |capsule: usize| groups_of[capsule];
         // A base capsule never moves: it has no group, and stands for itself. Within a pair of
         // groups the lowest floor first, so that a check stops at the first floor too high.
         let key = |pair: &SelfPair| (group_of(pair.link), group_of(pair.other));
-        self_pairs.sort_by(|p, r| {
-            (key(p).cmp(&key(r)))
+        // Indices sorted, then the pairs moved once: a pair is large to move.
+        let keys: Vec<_> = self_pairs.iter().map(key).collect();
+        let mut order: Vec<usize> = (0..self_pairs.len()).collect();
+        order.sort_by(|&k, &l| {
+            let (p, r) = (&self_pairs[k], &self_pairs[l]);
+            (keys[k].cmp(&keys[l]))
                 .then(p.floor.total_cmp(&r.floor))
                 .then((p.link, p.other).cmp(&(r.link, r.other)))
         });
+        let self_pairs: Vec<SelfPair> = order.iter().map(|&k| self_pairs[k].clone()).collect();
         let mut group_pairs: Vec<GroupPair> = Vec::new();
         for (k, pair) in self_pairs.iter().enumerate() {
             let (a, b) = key(pair);
@@ -375,38 +459,6 @@ impl CollisionModel {
                 }),
             }
         }
-        let (mut spheres, mut capsules, mut convex) = (Vec::new(), Vec::new(), Vec::new());
-        for body in &scene.bodies {
-            match body.shape {
-                Core::Ball(ball) => {
-                    let t = body.pose.translation;
-                    spheres
-                        .push(Sphere { center: Vector3::new(t.x, t.y, t.z), radius: ball.radius })
-                }
-                Core::Segment(s) => capsules.push(Capsule {
-                    a: Vector3::new(s.a.x, s.a.y, s.a.z),
-                    b: Vector3::new(s.b.x, s.b.y, s.b.z),
-                    radius: body.margin,
-                }),
-                Core::Cuboid(cuboid) => convex.push(Convex {
-                    body: body.clone(),
-                    rotation: rotation_of(&body.pose),
-                    solid: Solid::Cuboid { half: from_parry(cuboid.half_extents) },
-                }),
-                Core::Cylinder(cylinder) => {
-                    // parry's cylinder runs along its y; the closed form wants it along z.
-                    let z_to_y = Rotation3::from_axis_angle(&Vector3::x_axis(), -PI / 2.0);
-                    convex.push(Convex {
-                        body: body.clone(),
-                        rotation: rotation_of(&body.pose) * z_to_y.matrix(),
-                        solid: Solid::Cylinder {
-                            radius: cylinder.radius,
-                            half_height: cylinder.half_height,
-                        },
-                    })
-                }
-            }
-        }
         let hot = self_pairs
             .iter()
             .map(|p| HotPair {
@@ -418,7 +470,7 @@ impl CollisionModel {
                 floor: p.floor,
             })
             .collect();
-        Self { chain, links, groups, spheres, capsules, convex, self_pairs, hot, group_pairs }
+        Self { chain, links, groups, self_pairs, hot, group_pairs }
     }
 }
 
@@ -481,7 +533,7 @@ pub fn advancement_within(
 /// motion `dq` (m), from any configuration.
 pub fn motion_bound(model: &CollisionModel, dq: &JointVector) -> Real {
     let dq = dq.abs();
-    model.links.iter().map(|l| l.levers.dot(&dq)).fold(0.0, Real::max)
+    model.arm.links.iter().map(|l| l.levers.dot(&dq)).fold(0.0, Real::max)
 }
 
 impl CollisionModel {
@@ -496,7 +548,7 @@ impl CollisionModel {
         least: Real,
         enough: Real,
     ) -> Real {
-        let frames = self.chain.frames(q);
+        let frames = self.arm.chain.frames(q);
         // The configuration-independent motion bound first: cheap, and never below the
         // configuration's own, so it tells which pairs cannot lower `best`; the
         // configuration's own only for the nearest obstacle of a capsule that may.
@@ -506,7 +558,7 @@ impl CollisionModel {
             speed.map_or(Motion::UNIT, |speed| Motion::new(&frames, link, levers, speed, joints))
         };
         let mut best = enough;
-        for group in &self.groups {
+        for group in &self.arm.groups {
             let frame = &frames[group.frame];
             let center = frame.apply(&group.center);
             // Obstacles whose distance from the group's bounding sphere is this or more
@@ -522,11 +574,11 @@ impl CollisionModel {
             let mut below = [0.0; GROUP_SIZE];
             let mut found = [false; GROUP_SIZE];
             for (m, &i) in group.members.iter().enumerate() {
-                let capsule = &self.links[i];
+                let capsule = &self.arm.links[i];
                 below[m] = offset + loose(&capsule.levers).threshold(best) + capsule.radius;
             }
             // Members are placed when an obstacle first comes near the group.
-            let place = |m: usize| self.links[group.members[m]].posed(&frames);
+            let place = |m: usize| self.arm.links[group.members[m]].posed(&frames);
             for sphere in &self.spheres {
                 if (center - sphere.center).norm() - group.bound - sphere.radius >= near {
                     continue;
@@ -601,7 +653,7 @@ impl CollisionModel {
                 if !found[m] {
                     continue;
                 }
-                let capsule = &self.links[group.members[m]];
+                let capsule = &self.arm.links[group.members[m]];
                 let slack = below[m] - capsule.radius - offset;
                 if loose(&capsule.levers).reach(slack) < best {
                     let link = posed[m].get_or_insert_with(|| place(m));
@@ -615,12 +667,12 @@ impl CollisionModel {
         // A capsule is in many self pairs: its bounding sphere's centre placed once, and the
         // capsule itself once, only for a pair the bounding spheres do not settle.
         let mut centers = Centers::new();
-        let rates = speed.map(|speed| Rates::new(&self.links, speed));
+        let rates = speed.map(|speed| Rates::new(&self.arm.links, speed));
         let mut placed = Placed::new();
         let bounding = |group: usize| {
-            self.groups.get(group).map(|g| (frames[g.frame].apply(&g.center), g.bound))
+            self.arm.groups.get(group).map(|g| (frames[g.frame].apply(&g.center), g.bound))
         };
-        for group_pair in &self.group_pairs {
+        for group_pair in &self.arm.group_pairs {
             let loose_pair = loose(&group_pair.levers);
             // A pair whose floor is this high cannot lower `best`: its slack is at least the
             // floor's, and its own rate is at most the group pair's, which can only raise a
@@ -639,12 +691,12 @@ impl CollisionModel {
                     continue;
                 }
             }
-            for (k, pair) in self.hot[group_pair.pairs.clone()].iter().enumerate() {
+            for (k, pair) in self.arm.hot[group_pair.pairs.clone()].iter().enumerate() {
                 // Sorted by floor: the rest are higher still.
                 if pair.floor >= limit {
                     break;
                 }
-                let levers = || &self.self_pairs[group_pair.pairs.start + k].levers;
+                let levers = || &self.arm.self_pairs[group_pair.pairs.start + k].levers;
                 let loose = match (speed, &rates) {
                     (Some(_), Some(rates)) if pair.distal < Rates::CAPACITY => {
                         Motion::at_most(rates.rate(pair.distal, pair.start))
@@ -657,17 +709,17 @@ impl CollisionModel {
                 if reach.is_nan() || reach <= 0.0 {
                     continue;
                 }
-                let gap = centers.get(pair.link, &self.links, &frames)
-                    - centers.get(pair.other, &self.links, &frames);
+                let gap = centers.get(pair.link, &self.arm.links, &frames)
+                    - centers.get(pair.other, &self.arm.links, &frames);
                 if gap.norm_squared() >= reach * reach {
                     continue;
                 }
-                let link = placed.get(pair.link, &self.links, &frames);
-                let other = placed.get(pair.other, &self.links, &frames);
+                let link = placed.get(pair.link, &self.arm.links, &frames);
+                let other = placed.get(pair.other, &self.arm.links, &frames);
                 let moved = if pair.distal == pair.link { &link } else { &other };
                 let slack = link.distance(&other) - offset;
                 if loose.reach(slack) < best {
-                    let joints = pair.start..self.links[pair.distal].frame;
+                    let joints = pair.start..self.arm.links[pair.distal].frame;
                     let exact = exact(moved, levers(), joints);
                     best = best.min(exact.reach(slack));
                     if best < least {
@@ -800,7 +852,6 @@ fn floors(
         .collect();
     ranges.sort_unstable();
     ranges.dedup();
-    let mut posed: Vec<Option<Posed>> = vec![None; links.len()];
     for (start, end) in ranges {
         let members: Vec<usize> =
             (0..pairs.len()).filter(|&k| pairs[k].joints == (start..end)).collect();
@@ -809,6 +860,15 @@ fn floors(
         if (start..end).any(|j| !width(j).is_finite()) {
             continue;
         }
+        // The capsules of these pairs, placed once per cell, and each pair's two slots.
+        let mut used: Vec<usize> =
+            members.iter().flat_map(|&k| [pairs[k].link, pairs[k].other]).collect();
+        used.sort_unstable();
+        used.dedup();
+        let slot = |i: usize| used.partition_point(|&u| u < i);
+        let slots: Vec<(usize, usize)> =
+            members.iter().map(|&k| (slot(pairs[k].link), slot(pairs[k].other))).collect();
+        let mut posed: Vec<Posed> = Vec::with_capacity(used.len());
         let mut q = crate::robot::home(&robot.joints);
         let mut smallest = vec![Real::INFINITY; members.len()];
         for cell in 0..n.pow((end - start) as u32) {
@@ -818,12 +878,10 @@ fn floors(
                 rest /= n;
             }
             let frames = chain.frames(&q);
-            posed.iter_mut().for_each(|p| *p = None);
-            for (m, &k) in members.iter().enumerate() {
-                let (link, other) = (pairs[k].link, pairs[k].other);
-                let a = *posed[link].get_or_insert_with(|| links[link].posed(&frames));
-                let b = *posed[other].get_or_insert_with(|| links[other].posed(&frames));
-                smallest[m] = smallest[m].min(a.distance(&b));
+            posed.clear();
+            posed.extend(used.iter().map(|&i| links[i].posed(&frames)));
+            for (least, &(a, b)) in smallest.iter_mut().zip(&slots) {
+                *least = least.min(posed[a].distance(&posed[b]));
             }
         }
         for (m, &k) in members.iter().enumerate() {
@@ -983,7 +1041,15 @@ impl Posed {
 
     /// Signed distance to another capsule.
     fn distance(&self, other: &Posed) -> Real {
-        segment_segment_distance(&self.a, &self.b, &other.a, &other.b) - self.radius - other.radius
+        // Two spheres (most pairs of a spherised arm): the distance of the centres, the bits
+        // `segment_segment_distance` gives for two points (it takes s = t = 0 on the same
+        // test of the squared lengths), without its branches.
+        let core = if self.inverse_squared_length == 0.0 && other.inverse_squared_length == 0.0 {
+            (self.a - other.a).norm()
+        } else {
+            segment_segment_distance(&self.a, &self.b, &other.a, &other.b)
+        };
+        core - self.radius - other.radius
     }
 
     /// The squared distance from the segment to `p`.

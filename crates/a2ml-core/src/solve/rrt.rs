@@ -177,6 +177,30 @@ pub fn rrt_connect(
     rrt_connect_monitored(robot, scene, start, goals, options, &mut Monitor::silent())
 }
 
+/// [`rrt_connect`] with the arm's half of the collision model prepared once: `arm` is any
+/// [`CollisionModel`] of `robot` (its scene is not used), so that many problems of one robot
+/// do not each build its self pairs and their floors again. The same path as [`rrt_connect`].
+///
+/// # Errors
+/// As [`rrt_connect`]; [`RrtError::InvalidOptions`] when `arm` was not prepared for `robot`.
+pub fn rrt_connect_with(
+    arm: &CollisionModel,
+    robot: &Robot,
+    scene: &CollisionScene,
+    start: &JointVector,
+    goals: &[JointVector],
+    options: &RrtOptions,
+) -> Result<RrtPath, RrtError> {
+    check_options(options)?;
+    if !arm.fits(robot) {
+        return Err(RrtError::InvalidOptions {
+            reason: "the collision model was prepared for another robot",
+        });
+    }
+    let model = arm.with_scene(scene);
+    search(model, robot, scene, start, goals, options, &mut Monitor::silent())
+}
+
 /// [`rrt_connect`], reporting the fraction of the sample budget used to `monitor` and
 /// stopping at its deadline.
 ///
@@ -191,8 +215,21 @@ pub fn rrt_connect_monitored(
     monitor: &mut Monitor,
 ) -> Result<RrtPath, RrtError> {
     check_options(options)?;
+    search(CollisionModel::new(robot, scene), robot, scene, start, goals, options, monitor)
+}
+
+/// The search of [`rrt_connect_monitored`] with `model` prepared for `robot` and `scene`.
+fn search(
+    model: CollisionModel,
+    robot: &Robot,
+    scene: &CollisionScene,
+    start: &JointVector,
+    goals: &[JointVector],
+    options: &RrtOptions,
+    monitor: &mut Monitor,
+) -> Result<RrtPath, RrtError> {
     let mut monitor = monitor.within(options.max_time);
-    let mut space = JointSpace::new(robot, scene, options);
+    let mut space = JointSpace::new(robot, scene, options, model);
     if let Some(reason) = space.invalid(start) {
         return Err(RrtError::InvalidStart { reason });
     }
@@ -266,8 +303,12 @@ struct Gap {
 }
 
 impl<'a> JointSpace<'a> {
-    fn new(robot: &'a Robot, scene: &'a CollisionScene, options: &'a RrtOptions) -> Self {
-        let model = CollisionModel::new(robot, scene);
+    fn new(
+        robot: &'a Robot,
+        scene: &'a CollisionScene,
+        options: &'a RrtOptions,
+        model: CollisionModel,
+    ) -> Self {
         let started = Instant::now();
         Self { robot, scene, options, model, gaps: Vec::new(), checks: 0, started }
     }

@@ -59,14 +59,15 @@ fn capsules_move_within_their_motion_bounds() {
         let (lower, upper) = (robot.lower(), robot.upper());
         // (capsule, the frame it is seen from, its levers, the joints between)
         let mut cases: Vec<(usize, usize, JointVector, std::ops::Range<usize>)> = model
+            .arm
             .groups
             .iter()
             .flat_map(|g| g.members.iter())
-            .map(|&i| (i, 0, model.links[i].levers, 0..model.links[i].frame))
+            .map(|&i| (i, 0, model.arm.links[i].levers, 0..model.arm.links[i].frame))
             .collect();
-        for pair in &model.self_pairs {
+        for pair in &model.arm.self_pairs {
             let other = if pair.distal == pair.link { pair.other } else { pair.link };
-            let seen_from = model.links[other].frame;
+            let seen_from = model.arm.links[other].frame;
             cases.push((pair.distal, seen_from, pair.levers, pair.joints.clone()));
         }
         let mut tightest: Real = 0.0;
@@ -76,11 +77,11 @@ fn capsules_move_within_their_motion_bounds() {
             let mut dq = JointVector::zeros();
             dq[j] = rng.random_range(-3.0..3.0);
             dq[k] = rng.random_range(-3.0..3.0);
-            let frames = model.chain.frames(&q);
+            let frames = model.arm.chain.frames(&q);
             for (i, seen_from, levers, joints) in cases.clone() {
-                let capsule = &model.links[i];
+                let capsule = &model.arm.links[i];
                 let seen = |q: &JointVector| {
-                    let frames = model.chain.frames(q);
+                    let frames = model.arm.chain.frames(q);
                     let (from, posed) = (&frames[seen_from], capsule.posed(&frames));
                     let local = |p: Vector3| from.rotation.transpose() * (p - from.translation);
                     (local(posed.a), local(posed.b))
@@ -253,9 +254,10 @@ fn floor_robots() -> Vec<Robot> {
 /// The same model with no floors: every self pair checked as before them.
 fn without_floors(model: &CollisionModel) -> CollisionModel {
     let mut plain = model.clone();
-    plain.self_pairs.iter_mut().for_each(|p| p.floor = Real::NEG_INFINITY);
-    plain.hot.iter_mut().for_each(|p| p.floor = Real::NEG_INFINITY);
-    plain.group_pairs.iter_mut().for_each(|g| g.floor = Real::NEG_INFINITY);
+    let arm = Arc::make_mut(&mut plain.arm);
+    arm.self_pairs.iter_mut().for_each(|p| p.floor = Real::NEG_INFINITY);
+    arm.hot.iter_mut().for_each(|p| p.floor = Real::NEG_INFINITY);
+    arm.group_pairs.iter_mut().for_each(|g| g.floor = Real::NEG_INFINITY);
     plain
 }
 
@@ -280,11 +282,11 @@ fn self_pairs_keep_their_floors() {
                 }
                 _ => rng.random_range(lower[i]..upper[i]),
             });
-            let frames = model.chain.frames(&q);
-            for pair in model.self_pairs.iter().filter(|p| p.floor.is_finite()) {
-                let d = model.links[pair.link]
+            let frames = model.arm.chain.frames(&q);
+            for pair in model.arm.self_pairs.iter().filter(|p| p.floor.is_finite()) {
+                let d = model.arm.links[pair.link]
                     .posed(&frames)
-                    .distance(&model.links[pair.other].posed(&frames));
+                    .distance(&model.arm.links[pair.other].posed(&frames));
                 assert!(d >= pair.floor, "robot {r}: {d} below its floor {}", pair.floor);
                 tightest = tightest.min(d - pair.floor);
             }
@@ -295,7 +297,7 @@ fn self_pairs_keep_their_floors() {
             "robot {r}: the floors are never approached ({tightest})"
         );
         if r == 0 {
-            let two = model.self_pairs.iter().filter(|p| p.joints.len() == 2);
+            let two = model.arm.self_pairs.iter().filter(|p| p.joints.len() == 2);
             let high = two.clone().filter(|p| p.floor > 0.05).count();
             assert!(high * 4 > two.count(), "only {high} floors above 5 cm");
         }
@@ -354,8 +356,8 @@ fn rate_table_bounds_every_pair_dot_product() {
         let model = CollisionModel::new(&robot, &CollisionScene::new(&[]));
         for _ in 0..200 {
             let speed = JointVector::from_fn(|_, _| rng.random_range(0.0..3.0));
-            let rates = Rates::new(&model.links, &speed);
-            for (pair, hot) in model.self_pairs.iter().zip(&model.hot) {
+            let rates = Rates::new(&model.arm.links, &speed);
+            for (pair, hot) in model.arm.self_pairs.iter().zip(&model.arm.hot) {
                 assert_eq!(
                     (pair.link, pair.other, pair.joints.start),
                     (hot.link, hot.other, hot.start)
@@ -363,6 +365,37 @@ fn rate_table_bounds_every_pair_dot_product() {
                 let (table, dot) = (rates.rate(hot.distal, hot.start), pair.levers.dot(&speed));
                 assert!(table >= dot && table <= dot * (1.0 + 1e-12), "{table} vs {dot}");
             }
+        }
+    }
+}
+
+/// A model made for another scene from a prepared arm answers as one built from scratch, bit
+/// for bit: the arm's half depends on the robot alone.
+#[test]
+fn a_model_with_another_scene_answers_as_a_new_one() {
+    use crate::language::{Obstacle, Shape};
+    let shelf = [Obstacle {
+        name: "board".to_owned(),
+        shape: Shape::Box {
+            center: v(0.5, 0.1, 0.3),
+            size: v(0.3, 0.8, 0.02),
+            rotation: Rotation3::from_euler_angles(0.1, 0.2, 0.3),
+        },
+    }];
+    let mut rng = rand::rngs::StdRng::seed_from_u64(41);
+    for robot in floor_robots() {
+        let scene = CollisionScene::new(&shelf);
+        let fresh = CollisionModel::new(&robot, &scene);
+        let prepared = CollisionModel::new(&robot, &CollisionScene::new(&[])).with_scene(&scene);
+        assert!(prepared.fits(&robot));
+        let (lower, upper) = (robot.lower(), robot.upper());
+        for _ in 0..300 {
+            let q = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+            let dq = JointVector::from_fn(|_, _| rng.random_range(-1.0..1.0));
+            assert_eq!(clearance(&fresh, &q).to_bits(), clearance(&prepared, &q).to_bits());
+            let (a, b) =
+                (advancement(&fresh, &q, &dq, 0.01), advancement(&prepared, &q, &dq, 0.01));
+            assert_eq!(a.to_bits(), b.to_bits());
         }
     }
 }
