@@ -32,6 +32,8 @@ const DEPENDENCE: Real = 1e-10;
 const MAX_STEPS: usize = 100;
 
 /// How the dual method ended.
+// Returned by value once per step: boxing the solution would allocate at every binding step.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy)]
 pub(super) enum Outcome {
     /// The optimum, with the constraints active there and their multipliers.
@@ -48,7 +50,8 @@ pub(super) enum Outcome {
 pub(super) struct Solution {
     /// The minimiser.
     pub x: Vector7,
-    /// The constraints active at it.
+    /// The constraints active at it (what the tests check the KKT conditions with).
+    #[cfg_attr(not(test), allow(dead_code))]
     pub active: Active,
 }
 
@@ -163,7 +166,7 @@ impl Basis {
                 }
             }
             let length = v.norm();
-            if !(length > DEPENDENCE * a.norm()) {
+            if length.is_nan() || length <= DEPENDENCE * a.norm() {
                 return None;
             }
             basis.r[(k, k)] = length;
@@ -183,8 +186,8 @@ impl Basis {
             let head: Real = (0..i).map(|j| self.r[(j, i)] * w[j]).sum();
             w[i] = (residual - head) / self.r[(i, i)];
         }
-        for i in 0..self.len {
-            *u += self.q[i] * w[i];
+        for (q, w) in self.q[..self.len].iter().zip(&w[..self.len]) {
+            *u += q * *w;
         }
     }
 
@@ -252,8 +255,8 @@ pub(super) fn solve(cholesky: &Factor, c: &Vector7, constraints: &Constraints) -
             if moves {
                 u -= z * t;
             }
-            for j in 0..active.len {
-                active.lambda[j] -= t * r[j];
+            for (lambda, r) in active.lambda[..active.len].iter_mut().zip(&r) {
+                *lambda -= t * r;
             }
             added += t;
             if full <= partial {
