@@ -5,9 +5,10 @@
 //! before the position limits and one velocity-damper row per arm-obstacle pair inside the
 //! influence distance. J is square, so the unconstrained minimiser almost always tracks V
 //! exactly; when it already satisfies every bound and row it is the QP's solution. When some
-//! bind, a few exact active-set steps on the same Cholesky factor usually find the solution
-//! (verified by the KKT conditions); Clarabel solves the steps where they do not. Clarabel is
-//! used here only.
+//! bind, the dual active-set method of Goldfarb and Idnani ([`dual`]) on the same Cholesky
+//! factor solves the step exactly in finitely many steps; Clarabel only confirms or solves the
+//! steps it reports infeasible or degenerate (counted in [`QpStats::clarabel_steps`]).
+//! Clarabel is used here only.
 //!
 //! The QP is a [`Resolver`] of the shared control loop ([`super::control`]), which settles,
 //! detects stalls and brakes (by holding the state reached). The arm's velocity does not jump
@@ -25,6 +26,8 @@ use clarabel::solver::{
     DefaultSettings, DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
 
+mod dual;
+
 use super::control::{
     ControlError, ControlOptions, Integration, Resolved, Resolver, run_monitored,
 };
@@ -33,7 +36,7 @@ use super::monitor::Monitor;
 use super::problem::width;
 pub use super::problem::{Component, SegmentProblem};
 use super::report::{QpStats, Tolerance};
-use crate::collision::{self, CollisionScene, DistanceOptions, Proximity};
+use crate::collision::{self, CollisionModel, CollisionScene, DistanceOptions, Proximity};
 use crate::kinematics::{
     ArmPose, KinematicsError, cpsa_jacobian, cpsa_state, hat_jacobian, hat_state, point_jacobian,
 };
@@ -116,6 +119,10 @@ impl Default for QpOptions {
 /// as (m/s or rad/s): negligible against the feedback towards the path, thick enough for the
 /// interior-point solver's tolerances.
 const PATH_SLACK: Real = 1e-6;
+/// How far parry's distance may lie from the exact closed-form one of
+/// [`collision::clearance`] (m): its GJK stops up to 1e-5 m off (README, "Speed"); ten times
+/// that.
+const PARRY_SLACK: Real = 1e-4;
 /// Step in σ of the central difference giving the path's tangent.
 const TANGENT_STEP: Real = 1e-6;
 
@@ -323,8 +330,11 @@ struct Controller<'a> {
     speed: JointVector,
     /// The acceleration each step may use (rad/s²).
     acceleration: JointVector,
-    /// Created at the first step where a constraint binds.
+    /// Created at the first step the dual method leaves to Clarabel.
     clarabel: Option<Clarabel>,
+    /// The arm and scene for the closed-form clearance that tells when no pair is inside the
+    /// influence distance (then parry's closest points are not needed).
+    model: CollisionModel,
     timing: Timing,
     /// The component errors at the last step of the segment's own problem.
     errors: [Real; 3],
@@ -354,6 +364,7 @@ impl<'a> Controller<'a> {
             acceleration: robot.acceleration_limits()
                 * (options.acceleration_scale * options.acceleration_fraction),
             clarabel: None,
+            model: CollisionModel::new(robot, scene),
             timing: Timing::default(),
             errors: [Real::INFINITY; 3],
             max_errors: [0.0; 3],
@@ -381,7 +392,7 @@ impl<'a> Controller<'a> {
         let c = weighted.transpose() * target;
         let (lower, upper) = self.bounds(q);
         let ramp = self.ramp(&lower, &upper, current);
-        let mut rows = self.damper_rows(pose);
+        let mut rows = self.damper_rows(pose, q);
         let dampers = rows.len();
         if self.options.hard_path {
             rows.extend(self.path_rows(&jacobian, &values));
@@ -400,6 +411,11 @@ impl<'a> Controller<'a> {
 
     /// The step QP's solution within the acceleration box `ramp` when it holds with the rows,
     /// else within the velocity box `bounds` (the rows kept); whether Clarabel was needed.
+    ///
+    /// The dual active-set method ([`dual`]) solves the step exactly; Clarabel only where it
+    /// reports the problem infeasible (Clarabel confirms it, or solves what rounding made
+    /// look so) or degenerate, and where P has no Cholesky factor (no regularisation, a
+    /// singular J).
     fn solve_step(
         &mut self,
         p: &Matrix7,
@@ -410,8 +426,12 @@ impl<'a> Controller<'a> {
         t: Real,
     ) -> Result<(Vector7, bool), QpError> {
         let cholesky = p.cholesky();
-        let exact = |lower: &Vector7, upper: &Vector7| {
-            cholesky.as_ref().and_then(|ch| structured_solve(ch, c, lower, upper, rows))
+        let exact = |lower: &Vector7, upper: &Vector7| match &cholesky {
+            Some(ch) => match dual::solve(ch, c, &dual::Constraints { lower, upper, rows }) {
+                dual::Outcome::Solved(solution) => Some(solution.x),
+                dual::Outcome::Infeasible | dual::Outcome::Degenerate => None,
+            },
+            None => None,
         };
         Ok(match exact(&ramp_lower, &ramp_upper) {
             Some(x) => (x, false),
@@ -572,7 +592,18 @@ impl<'a> Controller<'a> {
     /// One row a·x ≤ b per arm-obstacle pair inside the influence distance: the speed at
     /// which the closest points approach, -nᵀ (J_link - J_other) x, is at most
     /// ξ (d - d_s) / (d_i - d_s).
-    fn damper_rows(&self, pose: &ArmPose) -> Vec<(Vector7, Real)> {
+    fn damper_rows(&self, pose: &ArmPose, q: &JointVector) -> Vec<(Vector7, Real)> {
+        let o = self.options;
+        // Every pair beyond the influence distance by more than parry can be off the exact
+        // distance: parry would report none.
+        if collision::clearance(&self.model, q) > o.influence + PARRY_SLACK {
+            return Vec::new();
+        }
+        self.parry_damper_rows(pose)
+    }
+
+    /// [`Controller::damper_rows`] from parry's closest points of every pair.
+    fn parry_damper_rows(&self, pose: &ArmPose) -> Vec<(Vector7, Real)> {
         let o = self.options;
         let near = collision::distances(
             self.robot,
@@ -724,95 +755,6 @@ fn normal_basis(tangent: &nalgebra::DVector<Real>) -> Vec<nalgebra::DVector<Real
             &e - &v * (2.0 * v[i] / vv)
         })
         .collect()
-}
-
-/// The QP's solution when its structure gives it exactly, else `None` (then Clarabel decides).
-///
-/// First the unconstrained minimiser x = P⁻¹c: if it satisfies every bound and row it is the
-/// solution. Otherwise a few steps of a primal active-set method, started from the
-/// constraints it violates: with the active ones as equalities A x = b,
-/// x = P⁻¹(c - Aᵀλ) with (A P⁻¹ Aᵀ) λ = A P⁻¹ c - b; a negative multiplier leaves the set,
-/// the most violated other constraint joins it. When every λ ≥ 0 and x satisfies the rest,
-/// the KKT conditions hold and, the problem being convex, x is the solution.
-fn structured_solve(
-    cholesky: &nalgebra::Cholesky<Real, nalgebra::Const<DOF>>,
-    c: &Vector7,
-    lower: &Vector7,
-    upper: &Vector7,
-    rows: &[(Vector7, Real)],
-) -> Option<Vector7> {
-    const TOL: Real = 1e-12;
-    const ITERATIONS: usize = 8;
-    let x0 = cholesky.solve(c);
-    // Every constraint as a·x ≤ b: x_i ≤ u_i, -x_i ≤ -l_i, then the damper rows.
-    let constraint = |k: usize| -> (Vector7, Real) {
-        match k {
-            k if k < DOF => (Vector7::ith(k, 1.0), upper[k]),
-            k if k < 2 * DOF => (Vector7::ith(k - DOF, -1.0), -lower[k - DOF]),
-            k => rows[k - 2 * DOF],
-        }
-    };
-    let count = 2 * DOF + rows.len();
-    let excess = |x: &Vector7, k: usize| {
-        let (a, b) = constraint(k);
-        a.dot(x) - b
-    };
-    let mut active: Vec<usize> = (0..count).filter(|&k| excess(&x0, k) > TOL).collect();
-    if active.is_empty() {
-        return Some(x0);
-    }
-    for _ in 0..ITERATIONS {
-        if active.len() > DOF {
-            return None;
-        }
-        let (x, lambda) = equality_solve(cholesky, &x0, &active, &constraint)?;
-        let (worst, most_negative) = lambda
-            .iter()
-            .enumerate()
-            .fold((0, 0.0), |best, (r, l)| if *l < best.1 { (r, *l) } else { best });
-        if most_negative < -TOL {
-            active.remove(worst);
-            continue;
-        }
-        let violated = (0..count)
-            .filter(|k| !active.contains(k))
-            .map(|k| (k, excess(&x, k)))
-            .filter(|(_, e)| *e > TOL)
-            .max_by(|a, b| a.1.total_cmp(&b.1));
-        match violated {
-            None => return Some(x),
-            Some((k, _)) => active.push(k),
-        }
-    }
-    None
-}
-
-/// The minimiser of ½xᵀPx - cᵀx with the `active` constraints as equalities, and their
-/// multipliers; `None` when they are dependent.
-fn equality_solve(
-    cholesky: &nalgebra::Cholesky<Real, nalgebra::Const<DOF>>,
-    x0: &Vector7,
-    active: &[usize],
-    constraint: &impl Fn(usize) -> (Vector7, Real),
-) -> Option<(Vector7, nalgebra::DVector<Real>)> {
-    let m = active.len();
-    if m == 0 {
-        return Some((*x0, nalgebra::DVector::zeros(0)));
-    }
-    let mut p_inv_at = nalgebra::DMatrix::<Real>::zeros(DOF, m);
-    let mut rhs = nalgebra::DVector::<Real>::zeros(m);
-    for (r, &k) in active.iter().enumerate() {
-        let (a, b) = constraint(k);
-        p_inv_at.set_column(r, &cholesky.solve(&a));
-        rhs[r] = a.dot(x0) - b;
-    }
-    // A P⁻¹ Aᵀ, entry (r, s) = a_r · (P⁻¹ a_s).
-    let schur = nalgebra::DMatrix::<Real>::from_fn(m, m, |r, s| {
-        constraint(active[r]).0.dot(&p_inv_at.column(s).fixed_rows::<DOF>(0).into_owned())
-    });
-    let lambda = schur.cholesky()?.solve(&rhs);
-    let shift = &p_inv_at * &lambda;
-    Some((x0 - Vector7::from_column_slice(shift.as_slice()), lambda))
 }
 
 /// J_p of the link's closest point, minus that of the other capsule's closest point when the
@@ -1118,43 +1060,301 @@ mod tests {
         }
     }
 
+    /// Checks the KKT conditions of `solution` for ½xᵀPx − cᵀx, a·x ≤ b, independently of
+    /// how it was found: feasible, multipliers nonnegative and zero off the constraints' edges,
+    /// and Px − c + Σλa = 0, each to 1e-9 of the size of its terms.
+    fn assert_kkt(p: &Matrix7, c: &Vector7, constraints: &dual::Constraints, s: &dual::Solution) {
+        let x = s.x;
+        let scale = 1.0 + x.amax();
+        for k in 0..constraints.len() {
+            let (a, b) = constraints.get(k);
+            assert!(a.dot(&x) - b <= 1e-9 * (scale + b.abs()), "constraint {k} violated: {x}");
+        }
+        let mut gradient = p * x - c;
+        for (k, lambda) in s.active.multipliers() {
+            let (a, b) = constraints.get(k);
+            assert!(lambda >= -1e-9, "multiplier {k} negative: {lambda}");
+            let slack = (a.dot(&x) - b).abs();
+            assert!(slack <= 1e-9 * (scale + b.abs()), "constraint {k} not tight: {slack}");
+            gradient += a * lambda;
+        }
+        let size = (p.abs() * x.abs()).amax() + c.amax() + 1.0;
+        assert!(gradient.amax() <= 1e-9 * size, "stationarity residual {}", gradient.amax());
+    }
+
+    /// Bounds cutting some joints of the unconstrained step, and rows cutting it off; one
+    /// instance in eight made infeasible (a row against a box it cannot meet).
+    fn random_instance(
+        rng: &mut StdRng,
+        exact: &Vector7,
+    ) -> (Vector7, Vector7, Vec<(Vector7, Real)>) {
+        // A joint speed limit's scale: a step QP's velocities are within a few rad/s.
+        let mut upper = Vector7::repeat(10.0);
+        let mut lower = Vector7::repeat(-10.0);
+        let exact = &exact.map(|v| v.clamp(-10.0, 10.0));
+        for _ in 0..rng.random_range(0..6) {
+            let i = rng.random_range(0..DOF);
+            let cut = rng.random_range(-0.5..0.9) * exact[i];
+            if exact[i] > 0.0 { upper[i] = cut.max(lower[i]) } else { lower[i] = cut.min(upper[i]) }
+        }
+        let mut rows: Vec<(Vector7, Real)> = (0..rng.random_range(0..5))
+            .map(|_| {
+                let a = Vector7::from_fn(|_, _| rng.random_range(-1.0..1.0));
+                let b = a.dot(exact) * rng.random_range(-0.5..1.0);
+                (a, b)
+            })
+            .collect();
+        if rng.random_range(0..8) == 0 {
+            let box_ = Vector7::repeat(0.1);
+            let (upper_, lower_) = (box_, -box_);
+            upper = upper.inf(&upper_);
+            lower = lower.sup(&lower_).inf(&upper);
+            rows.push((Vector7::ith(0, 1.0) + Vector7::ith(1, 1.0), -1.0));
+        }
+        (lower, upper, rows)
+    }
+
     #[test]
-    fn the_structured_solution_is_clarabels_whenever_it_is_given() {
+    fn the_dual_method_meets_the_kkt_conditions_and_agrees_with_clarabel() {
         let mut rng = StdRng::seed_from_u64(3);
-        let mut solver = Clarabel::new(2).expect("set up");
-        let mut given = 0;
+        let mut solver = Clarabel::new(8).expect("set up");
+        let (mut bound, mut infeasible) = (0, 0);
+        for instance in 0..4000 {
+            let (mut p, c) = random_problem(&mut rng);
+            if instance % 4 == 0 {
+                // A nearly singular J, as at the edge of a representation's validity.
+                let (u, s, v) = {
+                    let svd = p.svd(true, true);
+                    (svd.u.expect("u"), svd.singular_values, svd.v_t.expect("v"))
+                };
+                let mut s = s;
+                s[DOF - 1] = 1e-6;
+                p = u * Matrix7::from_diagonal(&s) * v;
+                p = 0.5 * (p + p.transpose());
+            }
+            let Some(ch) = p.cholesky() else { continue };
+            let exact = ch.solve(&c);
+            let (lower, upper, rows) = random_instance(&mut rng, &exact);
+            let constraints = dual::Constraints { lower: &lower, upper: &upper, rows: &rows };
+            let reference = solver.solve(&p, &c, &lower, &upper, &rows);
+            match dual::solve(&ch, &c, &constraints) {
+                dual::Outcome::Solved(s) => {
+                    assert_kkt(&p, &c, &constraints, &s);
+                    bound += usize::from(s.active.multipliers().count() > 0);
+                    // Clarabel stops at its 1e-7 tolerances: the same optimum to those.
+                    let (x, _) = reference.unwrap_or_else(|e| {
+                        panic!(
+                            "instance {instance}: Clarabel {e:?}; {lower} {upper} {rows:?} {}",
+                            s.x
+                        )
+                    });
+                    let (mine, theirs) = (objective(&p, &c, &s.x), objective(&p, &c, &x));
+                    assert!(
+                        (mine - theirs).abs() <= 1e-6 * (1.0 + theirs.abs()),
+                        "{mine} {theirs}"
+                    );
+                }
+                dual::Outcome::Infeasible => {
+                    infeasible += 1;
+                    assert!(
+                        matches!(
+                            reference,
+                            Err(ClarabelFailure::Status(
+                                ClarabelStatus::PrimalInfeasible
+                                    | ClarabelStatus::AlmostPrimalInfeasible
+                            ))
+                        ),
+                        "instance {instance}: Clarabel {reference:?}"
+                    );
+                }
+                dual::Outcome::Degenerate => panic!("instance {instance}: degenerate"),
+            }
+        }
+        // Most instances have binding constraints, some none can satisfy.
+        assert!(bound > 2500 && infeasible > 300, "{bound} bound, {infeasible} infeasible");
+    }
+
+    #[test]
+    fn with_nothing_violated_the_dual_answer_is_the_least_squares_step_bit_for_bit() {
+        let mut rng = StdRng::seed_from_u64(4);
         for _ in 0..200 {
             let (p, c) = random_problem(&mut rng);
             let ch = p.cholesky().expect("positive definite");
             let exact = ch.solve(&c);
-            // Bounds cutting one to three joints, sometimes a row.
-            let mut upper = Vector7::repeat(1e3);
-            let mut lower = Vector7::repeat(-1e3);
-            for _ in 0..rng.random_range(1..4) {
-                let i = rng.random_range(0..DOF);
-                let cut = 0.5 * exact[i];
-                if cut > 0.0 { upper[i] = cut } else { lower[i] = cut }
-            }
-            let rows: Vec<(Vector7, Real)> = if rng.random_range(0.0..1.0) < 0.5 {
-                vec![(Vector7::from_fn(|_, _| rng.random_range(-1.0..1.0)), 0.0)]
-            } else {
-                Vec::new()
+            let bound = Vector7::repeat(10.0 * exact.amax() + 1.0);
+            let lower = -bound;
+            let constraints = dual::Constraints { lower: &lower, upper: &bound, rows: &[] };
+            let dual::Outcome::Solved(s) = dual::solve(&ch, &c, &constraints) else {
+                panic!("solves")
             };
-            let (reference, _) = solver.solve(&p, &c, &lower, &upper, &rows).expect("solves");
-            if let Some(x) = structured_solve(&ch, &c, &lower, &upper, &rows) {
-                given += 1;
-                // Feasible, no worse than Clarabel's answer, and close to it (Clarabel stops
-                // at its 1e-7 tolerances on these badly conditioned problems).
-                let feasible = (0..DOF).all(|i| x[i] >= lower[i] - 1e-9 && x[i] <= upper[i] + 1e-9)
-                    && rows.iter().all(|(a, b)| a.dot(&x) <= b + 1e-9);
-                assert!(feasible, "{x}");
-                let (mine, theirs) = (objective(&p, &c, &x), objective(&p, &c, &reference));
-                assert!(mine <= theirs + 1e-9 * (1.0 + theirs.abs()), "{mine} > {theirs}");
-                assert!((x - reference).amax() < 1e-3 * (1.0 + x.amax()), "{x} vs {reference}");
-            }
+            assert_eq!(s.x, exact);
         }
-        // The structure is worth having: most of these problems need no interior point.
-        assert!(given > 100, "{given}");
+    }
+
+    /// The QPs of real steps: COMAN's wrist along a line past a box close enough for damper
+    /// rows, with slow joints so that bounds bind; each sample's step QP rebuilt by the
+    /// controller and solved both ways.
+    #[test]
+    fn recorded_steps_are_solved_exactly() {
+        use crate::kinematics::arm_pose;
+        use crate::language::{Obstacle, PathFeature, Shape};
+        use crate::math::{Rotation3, Vector3};
+        use crate::profile::BodyFrames;
+
+        let robot = Robot::from_urdf_file(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../robots/coman_right_arm.urdf"
+        ))
+        .expect("robot");
+        let q0 = JointVector::from_fn(|i, _| [-10.0, -15.0, 45.0, -100.0, 0.0, 0.0, 0.0][i])
+            .map(Real::to_radians);
+        let pose0 = arm_pose(&robot, &q0);
+        let s = cpsa_state(&robot, &pose0).expect("regular start");
+        let duration = 1.2;
+        let line =
+            PathFeature::Line { direction: Vector3::new(0.0, -1.0, 0.2), length: Some(0.12) };
+        let frames = BodyFrames { shoulder_frame: Rotation3::identity(), ow: s.ow };
+        let held = |variable, value| Reference::hold(variable, value, duration).expect("hold");
+        let pw = Reference::path(Variable::Pw, Target::Position(s.pw), &line, &frames, duration)
+            .expect("line");
+        let component = |variable, reference| Component { variable, reference, role: Role::Path };
+        let problem = SegmentProblem {
+            space: Space::Cpsa,
+            components: [
+                component(Variable::Pw, pw),
+                component(Variable::Ow, held(Variable::Ow, Target::Rotation(s.ow))),
+                component(Variable::Swivel, held(Variable::Swivel, Target::Angle(s.swivel))),
+            ],
+            duration,
+        };
+        let slab = Obstacle {
+            name: "slab".into(),
+            shape: Shape::Box {
+                center: pose0.wrist + Vector3::new(0.0, -0.08, -0.07),
+                size: Vector3::new(0.3, 0.1, 0.05),
+                rotation: Rotation3::identity(),
+            },
+        };
+        let scene = CollisionScene::new(&[slab]);
+        let options = QpOptions { velocity_fraction: 0.3, ..QpOptions::default() };
+        let solved = solve_segment(&robot, &scene, &problem, &q0, &options).expect("solves");
+        let mut controller = Controller::new(&robot, &scene, problem, &options);
+        let mut clarabel = Clarabel::new(8).expect("set up");
+        let (mut binding, mut rows_seen, mut infeasible) = (0, 0, 0);
+        let tr = &solved.trajectory;
+        for k in 0..tr.len() {
+            let (q, current, t) = (tr.positions()[k], tr.velocities()[k], tr.times()[k]);
+            let pose = arm_pose(&robot, &q);
+            let (jacobian, values) = controller.measure(&pose).expect("regular");
+            let (target, weights, _) = controller.task(t, &values);
+            let weighted = Matrix7::from_diagonal(&weights.component_mul(&weights)) * jacobian;
+            let p = jacobian.transpose() * weighted + Matrix7::identity() * 1e-6;
+            let c = weighted.transpose() * target;
+            let (lower, upper) = controller.bounds(&q);
+            let (ramp_lower, ramp_upper) = controller.ramp(&lower, &upper, &current);
+            let rows = controller.damper_rows(&pose, &q);
+            rows_seen += usize::from(!rows.is_empty());
+            let constraints =
+                dual::Constraints { lower: &ramp_lower, upper: &ramp_upper, rows: &rows };
+            let ch = p.cholesky().expect("positive definite");
+            let mut outcome = dual::solve(&ch, &c, &constraints);
+            let mut constraints = constraints;
+            if matches!(outcome, dual::Outcome::Infeasible) {
+                // As the controller does: Clarabel confirms it, and the rows are kept within
+                // the velocity box.
+                infeasible += 1;
+                let reference = clarabel.solve(&p, &c, &ramp_lower, &ramp_upper, &rows);
+                assert!(
+                    matches!(
+                        reference,
+                        Err(ClarabelFailure::Status(ClarabelStatus::PrimalInfeasible))
+                    ),
+                    "step {k}: Clarabel {reference:?}"
+                );
+                constraints = dual::Constraints { lower: &lower, upper: &upper, rows: &rows };
+                outcome = dual::solve(&ch, &c, &constraints);
+            }
+            let dual::Outcome::Solved(s) = outcome else { panic!("step {k}: {outcome:?}") };
+            assert_kkt(&p, &c, &constraints, &s);
+            if s.active.multipliers().count() > 0 {
+                binding += 1;
+                let (x, _) = clarabel
+                    .solve(&p, &c, constraints.lower, constraints.upper, &rows)
+                    .expect("Clarabel solves it");
+                let (mine, theirs) = (objective(&p, &c, &s.x), objective(&p, &c, &x));
+                assert!((mine - theirs).abs() <= 1e-6 * (1.0 + theirs.abs()), "{mine} {theirs}");
+            }
+            controller.clarabel = None;
+        }
+        assert!(binding > 50 && rows_seen > 50, "{binding} binding, {rows_seen} with rows");
+        eprintln!(
+            "{} steps: {binding} binding, {rows_seen} with rows, {infeasible} infeasible",
+            tr.len()
+        );
+    }
+
+    /// The closed-form clearance leaves out only steps where parry finds no pair inside the
+    /// influence distance: the rows are parry's at every configuration.
+    #[test]
+    fn damper_rows_are_parrys_rows() {
+        use crate::kinematics::arm_pose;
+        use crate::language::{Obstacle, Shape};
+        use crate::math::{Rotation3, Vector3};
+
+        let robot = Robot::from_urdf_file(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../robots/coman_right_arm.urdf"
+        ))
+        .expect("robot");
+        let q0 = JointVector::from_fn(|i, _| [-10.0, -15.0, 45.0, -100.0, 0.0, 0.0, 0.0][i])
+            .map(Real::to_radians);
+        let wrist = arm_pose(&robot, &q0).wrist;
+        let obstacles = [
+            Obstacle {
+                name: "slab".into(),
+                shape: Shape::Box {
+                    center: wrist + Vector3::new(0.0, -0.08, -0.09),
+                    size: Vector3::new(0.3, 0.1, 0.05),
+                    rotation: Rotation3::from_euler_angles(0.3, 0.1, 0.0),
+                },
+            },
+            Obstacle {
+                name: "post".into(),
+                shape: Shape::Cylinder {
+                    center: wrist + Vector3::new(0.1, 0.05, 0.0),
+                    radius: 0.03,
+                    height: 0.4,
+                    rotation: Rotation3::identity(),
+                },
+            },
+        ];
+        let scene = CollisionScene::new(&obstacles);
+        let problem = SegmentProblem {
+            space: Space::Cpsa,
+            components: std::array::from_fn(|k| {
+                let variable = [Variable::Pw, Variable::Ow, Variable::Swivel][k];
+                let value = [
+                    Target::Position(wrist),
+                    Target::Rotation(Rotation3::identity()),
+                    Target::Angle(0.0),
+                ][k];
+                let reference = Reference::hold(variable, value, 1.0).expect("hold");
+                Component { variable, reference, role: Role::Path }
+            }),
+            duration: 1.0,
+        };
+        let options = QpOptions::default();
+        let controller = Controller::new(&robot, &scene, problem, &options);
+        let mut rng = StdRng::seed_from_u64(5);
+        let (mut with_rows, mut without) = (0, 0);
+        for _ in 0..3000 {
+            let q = q0 + JointVector::from_fn(|_, _| rng.random_range(-1.5..1.5));
+            let pose = arm_pose(&robot, &q);
+            let rows = controller.damper_rows(&pose, &q);
+            assert_eq!(rows, controller.parry_damper_rows(&pose), "at {q}");
+            if rows.is_empty() { without += 1 } else { with_rows += 1 }
+        }
+        assert!(with_rows > 200 && without > 200, "{with_rows} with rows, {without} without");
     }
 
     #[test]

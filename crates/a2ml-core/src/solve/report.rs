@@ -81,8 +81,9 @@ impl Fallback {
 pub struct QpStats {
     /// Control steps taken.
     pub steps: usize,
-    /// Steps that Clarabel solved: a bound or row binds and the exact active-set step did not
-    /// settle (see [`crate::solve::qp`]).
+    /// Steps that needed Clarabel: the exact dual active-set method found the step's
+    /// constraints infeasible (Clarabel confirms it or solves the step) or degenerate (see
+    /// [`crate::solve::qp`]).
     pub clarabel_steps: usize,
     /// Of those, the steps Clarabel ended `almost_solved` (see [`crate::solve::qp`] on why they
     /// are accepted).

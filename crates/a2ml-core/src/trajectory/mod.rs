@@ -409,9 +409,10 @@ pub struct Clearance {
 
 /// The smallest [`collision::min_distance`] over the trajectory's samples, with when and
 /// between what it occurs (the first worst sample); `None` when there is no pair to measure.
-/// The same as [`distance_pass`]'s clearance, without the per-capsule series: the
-/// bounding-sphere phase skips every pair that cannot beat the closest so far, and
-/// [`clearance_bound`] every sample that cannot.
+/// The same as [`distance_pass`]'s clearance, without the per-capsule series. parry measures
+/// only the samples that may be the worst: [`clearance_bound`] leaves out those near a sample
+/// already measured, and the exact closed-form [`collision::clearance`] those whose distance,
+/// less what parry may be off by ([`MEASURE_SLACK`]), is above the smallest so far.
 pub fn min_clearance(
     trajectory: &Trajectory,
     robot: &Robot,
@@ -419,19 +420,21 @@ pub fn min_clearance(
 ) -> Option<Clearance> {
     let measure = |q: &JointVector| collision::min_distance(robot, &arm_pose(robot, q), scene);
     let (times, positions) = (&trajectory.times, &trajectory.positions);
+    let model = collision::CollisionModel::new(robot, scene);
+    let exact = |q: &JointVector| collision::clearance(&model, q);
     // A first look at every STRIDE-th sample (and the last) bounds the smallest distance
-    // from above, so that the pass below can leave out the samples far from it.
+    // from above, so that the pass below can leave out the samples far from it. Above zero
+    // the closed form is within MEASURE_SLACK of parry; at or below zero the bound is only
+    // compared with zero.
     const STRIDE: usize = 16;
     let last = positions.len().checked_sub(1)?;
     let mut above = Real::INFINITY;
     for k in (0..last).step_by(STRIDE).chain([last]) {
-        if let Some((distance, ..)) = measure(&positions[k]) {
-            above = above.min(distance);
-        }
+        above = above.min(exact(&positions[k]) + MEASURE_SLACK);
     }
-    let model = collision::CollisionModel::new(robot, scene);
     let mut best: Option<Clearance> = None;
-    // The last sample measured: a sample near it in joint space is about as far away.
+    // The last sample measured (by either): a sample near it in joint space is about as far
+    // away.
     let mut anchor: Option<(&JointVector, Real)> = None;
     for (&time, q) in times.iter().zip(positions) {
         if let Some((measured, distance)) = anchor {
@@ -439,6 +442,11 @@ pub fn min_clearance(
             if bound > above.max(0.0) {
                 continue;
             }
+        }
+        let closed = exact(q);
+        anchor = Some((q, closed));
+        if closed - MEASURE_SLACK > above.max(0.0) {
+            continue;
         }
         let Some((distance, link, obstacle)) = measure(q) else { continue };
         anchor = Some((q, distance));
@@ -450,10 +458,11 @@ pub fn min_clearance(
     best
 }
 
-/// How much [`collision::min_distance`] may differ from the exact distance of a separated
-/// pair (m): parry's GJK stops up to 1e-5 m above it (README, "Speed"), and the closed forms
-/// are within 1e-11 m; ten times that, for a bound that is never too high.
-const MEASURE_SLACK: Real = 1e-4;
+/// How much [`collision::min_distance`] or [`collision::clearance`] may differ from the exact
+/// distance of a separated pair (m): parry's GJK stops up to 1e-5 m above it (README,
+/// "Speed"), and the closed forms are within 1e-11 m; ten times that, for a bound that is
+/// never too high.
+pub(crate) const MEASURE_SLACK: Real = 1e-4;
 
 /// A lower bound of [`collision::min_distance`] at `q` from its value `distance` at
 /// `measured`: no point of any capsule moves farther than [`collision::motion_bound`] between
