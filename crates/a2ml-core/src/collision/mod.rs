@@ -17,7 +17,7 @@ use parry3d_f64::shape::{Ball, Cuboid, Cylinder, Segment, Shape as ParryShape};
 
 use crate::kinematics::ArmPose;
 use crate::language::{Obstacle, Shape};
-use crate::math::{Real, Rotation3, UnitQuaternion, Vector3};
+use crate::math::{JointVector, Real, Rotation3, UnitQuaternion, Vector3};
 use crate::robot::{LinkRole, Robot};
 
 mod guard;
@@ -27,6 +27,26 @@ pub use guard::{ShapeError, check_shapes};
 pub use model::{
     CollisionModel, advancement, advancement_at_least, advancement_within, clearance, motion_bound,
 };
+
+/// How much [`min_distance`] or [`clearance`] may differ from the exact
+/// distance of a separated pair (m): parry's GJK stops up to 1e-5 m above it (README,
+/// "Speed"), and the closed forms are within 1e-11 m; ten times that, for a bound that is
+/// never too high.
+pub const MEASURE_SLACK: Real = 1e-4;
+
+/// A lower bound of [`min_distance`] at `q` from its value `distance` at
+/// `measured`: no point of any capsule moves farther than [`motion_bound`] between
+/// the two configurations, so no pair (a self pair's two capsules both moving) comes more
+/// than twice that closer, less what the measure itself may be off by ([`MEASURE_SLACK`],
+/// twice). Only a positive bound says anything: a penetration's depth has no such slack.
+pub fn clearance_bound(
+    model: &CollisionModel,
+    distance: Real,
+    measured: &JointVector,
+    q: &JointVector,
+) -> Real {
+    distance - 2.0 * motion_bound(model, &(q - measured)) - 2.0 * MEASURE_SLACK
+}
 
 /// The task's obstacles as parry shapes, positioned in {b}.
 ///

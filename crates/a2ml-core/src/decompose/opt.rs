@@ -360,12 +360,12 @@ impl Search<'_> {
     /// Whether the arm at `q` keeps the clearance from the scene and itself. The search
     /// evaluates configurations close to one another (finite differences, small steps): one
     /// whose distance is bounded from below by the last one measured
-    /// ([`crate::trajectory::clearance_bound`]) at the clearance or more is clear without
+    /// ([`crate::collision::clearance_bound`]) at the clearance or more is clear without
     /// measuring.
     fn clear(&mut self, q: &JointVector) -> bool {
         let Some(scene) = self.scene else { return true };
         if let (Some(model), Some((at, distance))) = (self.model, &self.measured) {
-            let bound = crate::trajectory::clearance_bound(model, *distance, at, q);
+            let bound = crate::collision::clearance_bound(model, *distance, at, q);
             if bound > 0.0 && bound >= self.kept {
                 return true;
             }
@@ -374,7 +374,7 @@ impl Search<'_> {
         // clearance kept; parry's answer is the one the plan's checks give.
         if let Some(model) = self.model {
             let exact = crate::collision::clearance(model, q);
-            let slack = crate::trajectory::MEASURE_SLACK;
+            let slack = crate::collision::MEASURE_SLACK;
             if exact > 0.0 && (exact - slack >= self.kept || exact + slack < self.kept) {
                 self.measured = Some((*q, exact));
                 return exact >= self.kept;

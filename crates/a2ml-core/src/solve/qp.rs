@@ -119,10 +119,6 @@ impl Default for QpOptions {
 /// as (m/s or rad/s): negligible against the feedback towards the path, thick enough for the
 /// interior-point solver's tolerances.
 const PATH_SLACK: Real = 1e-6;
-/// How far parry's distance may lie from the exact closed-form one of
-/// [`collision::clearance`] (m): its GJK stops up to 1e-5 m off (README, "Speed"); ten times
-/// that.
-const PARRY_SLACK: Real = 1e-4;
 /// Step in σ of the central difference giving the path's tangent.
 const TANGENT_STEP: Real = 1e-6;
 
@@ -596,7 +592,7 @@ impl<'a> Controller<'a> {
         let o = self.options;
         // Every pair beyond the influence distance by more than parry can be off the exact
         // distance: parry would report none.
-        if collision::clearance(&self.model, q) > o.influence + PARRY_SLACK {
+        if collision::clearance(&self.model, q) > o.influence + collision::MEASURE_SLACK {
             return Vec::new();
         }
         self.parry_damper_rows(pose)
@@ -1191,6 +1187,19 @@ mod tests {
         }
     }
 
+    /// COMAN's right arm and the start of the recorded-step tests: the elbow bent, the wrist
+    /// in front of the shoulder.
+    fn coman_bent_elbow() -> (Robot, JointVector) {
+        let robot = Robot::from_urdf_file(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../robots/coman_right_arm.urdf"
+        ))
+        .expect("robot");
+        let q0 = JointVector::from_fn(|i, _| [-10.0, -15.0, 45.0, -100.0, 0.0, 0.0, 0.0][i])
+            .map(Real::to_radians);
+        (robot, q0)
+    }
+
     /// The QPs of real steps: COMAN's wrist along a line past a box close enough for damper
     /// rows, with slow joints so that bounds bind; each sample's step QP rebuilt by the
     /// controller and solved both ways.
@@ -1201,13 +1210,7 @@ mod tests {
         use crate::math::{Rotation3, Vector3};
         use crate::profile::BodyFrames;
 
-        let robot = Robot::from_urdf_file(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../robots/coman_right_arm.urdf"
-        ))
-        .expect("robot");
-        let q0 = JointVector::from_fn(|i, _| [-10.0, -15.0, 45.0, -100.0, 0.0, 0.0, 0.0][i])
-            .map(Real::to_radians);
+        let (robot, q0) = coman_bent_elbow();
         let pose0 = arm_pose(&robot, &q0);
         let s = cpsa_state(&robot, &pose0).expect("regular start");
         let duration = 1.2;
@@ -1301,13 +1304,7 @@ mod tests {
         use crate::language::{Obstacle, Shape};
         use crate::math::{Rotation3, Vector3};
 
-        let robot = Robot::from_urdf_file(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../robots/coman_right_arm.urdf"
-        ))
-        .expect("robot");
-        let q0 = JointVector::from_fn(|i, _| [-10.0, -15.0, 45.0, -100.0, 0.0, 0.0, 0.0][i])
-            .map(Real::to_radians);
+        let (robot, q0) = coman_bent_elbow();
         let wrist = arm_pose(&robot, &q0).wrist;
         let obstacles = [
             Obstacle {

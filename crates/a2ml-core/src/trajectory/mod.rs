@@ -9,7 +9,7 @@
 //! samples' q and q', so the two stay consistent and the limits are checked at every instant
 //! of that curve, not only at the samples.
 
-use crate::collision::{self, CollisionScene};
+use crate::collision::{self, CollisionScene, MEASURE_SLACK, clearance_bound};
 use crate::kinematics::arm_pose;
 use crate::math::{DOF, JointVector, Real};
 use crate::profile::ProfileError;
@@ -410,9 +410,9 @@ pub struct Clearance {
 /// The smallest [`collision::min_distance`] over the trajectory's samples, with when and
 /// between what it occurs (the first worst sample); `None` when there is no pair to measure.
 /// The same as [`distance_pass`]'s clearance, without the per-capsule series. parry measures
-/// only the samples that may be the worst: [`clearance_bound`] leaves out those near a sample
+/// only the samples that may be the worst: [`collision::clearance_bound`] leaves out those near a sample
 /// already measured, and the exact closed-form [`collision::clearance`] those whose distance,
-/// less what parry may be off by ([`MEASURE_SLACK`]), is above the smallest so far.
+/// less what parry may be off by ([`collision::MEASURE_SLACK`]), is above the smallest so far.
 pub fn min_clearance(
     trajectory: &Trajectory,
     robot: &Robot,
@@ -456,24 +456,4 @@ pub fn min_clearance(
         }
     }
     best
-}
-
-/// How much [`collision::min_distance`] or [`collision::clearance`] may differ from the exact
-/// distance of a separated pair (m): parry's GJK stops up to 1e-5 m above it (README,
-/// "Speed"), and the closed forms are within 1e-11 m; ten times that, for a bound that is
-/// never too high.
-pub(crate) const MEASURE_SLACK: Real = 1e-4;
-
-/// A lower bound of [`collision::min_distance`] at `q` from its value `distance` at
-/// `measured`: no point of any capsule moves farther than [`collision::motion_bound`] between
-/// the two configurations, so no pair (a self pair's two capsules both moving) comes more
-/// than twice that closer, less what the measure itself may be off by ([`MEASURE_SLACK`],
-/// twice). Only a positive bound says anything: a penetration's depth has no such slack.
-pub(crate) fn clearance_bound(
-    model: &collision::CollisionModel,
-    distance: Real,
-    measured: &JointVector,
-    q: &JointVector,
-) -> Real {
-    distance - 2.0 * collision::motion_bound(model, &(q - measured)) - 2.0 * MEASURE_SLACK
 }
