@@ -171,3 +171,22 @@ fn the_forward_bar_is_solved_for_nearly_every_seed() {
     eprintln!("forward bar: {found} of 100 seeds found a path");
     assert!(found >= 99, "only {found} of 100 seeds found a path");
 }
+
+/// The velocities the timing writes (the Jacobian solved for the path's rate) are the
+/// derivative of the positions it writes (the IK along the path): central differences of
+/// the 500 Hz samples agree with them to the differences' own error.
+#[test]
+fn the_timed_velocities_are_the_derivative_of_the_timed_positions() {
+    let (robot, task) = load("type_iv_forward_bar.a2ml");
+    let plan = plan(&robot, &task, &options(SolverChoice::Rrt)).expect("a path");
+    let (times, positions, velocities) =
+        (plan.trajectory.times(), plan.trajectory.positions(), plan.trajectory.velocities());
+    let peak = velocities.iter().map(|v| v.amax()).fold(0.0, Real::max);
+    assert!(peak > 0.1, "the arm moves: peak joint speed {peak} rad/s");
+    let mut worst: Real = 0.0;
+    for k in 1..times.len() - 1 {
+        let difference = (positions[k + 1] - positions[k - 1]) / (times[k + 1] - times[k - 1]);
+        worst = worst.max((difference - velocities[k]).amax());
+    }
+    assert!(worst < 2e-3 * peak, "velocities differ from the positions' rate by {worst} rad/s");
+}

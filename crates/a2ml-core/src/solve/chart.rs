@@ -13,10 +13,13 @@ use super::problem::SegmentProblem;
 use super::report::Tolerance;
 use crate::decompose::{ArmState, goal_error};
 use crate::kinematics::{
-    CpsaState, HatState, ik_cpsa, ik_cpsa_nearest, ik_hat, ik_hat_nearest, swivel_intervals,
+    CpsaState, HatState, arm_pose, cpsa_jacobian, hat_jacobian, ik_cpsa, ik_cpsa_nearest, ik_hat,
+    ik_hat_nearest, swivel_intervals,
 };
 use crate::language::{Space, Target, Variable};
-use crate::math::{JointVector, PI, Real, Rotation3, rotation_distance, rotation_log, wrap_angle};
+use crate::math::{
+    JointVector, PI, Real, Rotation3, Vector7, rotation_distance, rotation_log, wrap_angle,
+};
 use crate::profile::{Reference, Role};
 use crate::robot::Robot;
 
@@ -283,6 +286,43 @@ impl Chart {
             _ => return Vec::new(),
         };
         solutions.unwrap_or_default()
+    }
+
+    /// dq/dτ at fraction `tau` of the edge from `a` to `b`, for `q` the IK solution there:
+    /// the segment space's Jacobian (J_cs or J_tr) solved for the rate of the chart point's
+    /// state, which is exact where the IK is smooth, and costs one FK and a 7×7 solve where a
+    /// difference of IK solutions costs two IK solves. The state's rate is a central
+    /// difference of [`Chart::interpolate`] (closed forms, no IK), one-sided at the edge's
+    /// ends. `None` where the Jacobian is singular or its state undefined (a straight arm, the
+    /// wrist above the shoulder): there the caller differentiates the IK itself.
+    pub fn joint_rate(
+        &self,
+        robot: &Robot,
+        (a, b): (&ChartPoint, &ChartPoint),
+        tau: Real,
+        q: &JointVector,
+    ) -> Option<JointVector> {
+        let h = 1e-6;
+        let (lo, hi) = ((tau - h).max(0.0), (tau + h).min(1.0));
+        let (behind, ahead) = (self.interpolate(a, b, lo), self.interpolate(a, b, hi));
+        let mut state_rate = Vector7::zeros();
+        let mut row = 0;
+        for (k, variable) in self.variables.iter().enumerate() {
+            let n = variable.dimension();
+            let d = variable.difference(&ahead.values[k], &behind.values[k])?;
+            for i in 0..n {
+                state_rate[row + i] = d[i] / (hi - lo);
+            }
+            row += n;
+        }
+        let pose = arm_pose(robot, q);
+        let jacobian = match self.space {
+            Space::Cpsa => cpsa_jacobian(robot, &pose),
+            Space::Hat => hat_jacobian(&pose),
+        }
+        .ok()?;
+        let rate = jacobian.lu().solve(&state_rate)?;
+        rate.iter().all(|v| v.is_finite()).then_some(rate)
     }
 
     /// The IK solution of `x` nearest to `near`, within the joint limits.

@@ -214,7 +214,7 @@ fn on_track(
 /// points): speed and acceleration vanish where pieces meet, so nothing steps there. Every
 /// sample on an edge is the IK of a chart point on the path, tracked on the path's branch, so
 /// the path constraint holds at every sample. Joint velocities are the IK's derivative along
-/// the path times the bell speed. Each piece takes its share of `duration` by length,
+/// the path ([`Chart::joint_rate`]) times the bell speed. Each piece takes its share of `duration` by length,
 /// stretched until its joints keep [`LIMIT_FRACTION`] of their velocity and acceleration
 /// limits.
 ///
@@ -327,12 +327,19 @@ fn time_piece(
                 let tau = (s / length).clamp(0.0, 1.0);
                 let at = |t: Real| on_track(robot, chart, (a, b), track, t);
                 let q = at(tau).ok_or_else(lost)?;
-                // dq/ds by a central difference on the same branch.
-                let h = 1e-6;
-                let (lo, hi) = ((tau - h).max(0.0), (tau + h).min(1.0));
-                let ahead = at(hi).ok_or_else(lost)?;
-                let behind = at(lo).ok_or_else(lost)?;
-                (q, (ahead - behind) / ((hi - lo) * length))
+                let rate = match chart.joint_rate(robot, (a, b), tau, &q) {
+                    Some(rate) => rate,
+                    None => {
+                        // A singular Jacobian: dq/dτ by a central difference on the same
+                        // branch.
+                        let h = 1e-6;
+                        let (lo, hi) = ((tau - h).max(0.0), (tau + h).min(1.0));
+                        let ahead = at(hi).ok_or_else(lost)?;
+                        let behind = at(lo).ok_or_else(lost)?;
+                        (ahead - behind) / (hi - lo)
+                    }
+                };
+                (q, rate / length)
             }
         };
         positions.push(q);
