@@ -39,6 +39,12 @@ pub const PI: Real = std::f64::consts::PI;
 #[inline]
 pub fn rotation_about(axis: &Vector3, angle: Real) -> Matrix3 {
     let (s, c) = angle.sin_cos();
+    rotation_from_sin_cos(axis, s, c)
+}
+
+/// [`rotation_about`] for an angle whose sine `s` and cosine `c` are at hand (IK has them
+/// from the root it solved for): the same matrix, bit for bit, without the trigonometry.
+pub fn rotation_from_sin_cos(axis: &Vector3, s: Real, c: Real) -> Matrix3 {
     let t = 1.0 - c;
     let (x, y, z) = (axis.x, axis.y, axis.z);
     Matrix3::new(

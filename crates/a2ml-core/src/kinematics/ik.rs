@@ -20,7 +20,7 @@ use super::spaces::{
 };
 use crate::math::{
     DOF, Few, JointVector, Matrix3, Matrix7, PI, Real, Rotation3, Vector3, Vector7, reject,
-    rotation_about, rotation_log, solve_trig, wrap_angle,
+    rotation_about, rotation_from_sin_cos, rotation_log, solve_trig, wrap_angle,
 };
 use crate::robot::{ArmStructure, Robot};
 
@@ -218,6 +218,9 @@ struct Turn {
 }
 
 impl Turn {
+    /// No turn: what `Turn::of(0.0)` gives, without calling the trigonometry.
+    const ZERO: Self = Self { angle: 0.0, sin: 0.0, cos: 1.0 };
+
     fn of(angle: Real) -> Self {
         let (sin, cos) = angle.sin_cos();
         Self { angle, sin, cos }
@@ -316,7 +319,7 @@ impl<'a> Split<'a> {
         }
         // Any direction orthogonal to wc shows the last angle.
         let probe = wc.cross(&if wc.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() });
-        let zero = (Vector3::zeros(), Turn::of(0.0));
+        let zero = (Vector3::zeros(), Turn::ZERO);
         let mut split =
             Self { wa, wb, wc, w, probe, r_probe: r * probe, near_a, middles: [zero; 2], len: 0 };
         let alpha = (wa.dot(&w) - k * wb.dot(&v)) / (1.0 - k * k);
@@ -331,7 +334,7 @@ impl<'a> Split<'a> {
         let gammas: &[Real] = if gamma < 1e-12 { &[0.0] } else { &[gamma, -gamma] };
         for &g in gammas {
             let c = alpha * wa + beta * wb + g * cross;
-            let b = rotation_turn(wb, &v, &c).unwrap_or_else(|| Turn::of(0.0));
+            let b = rotation_turn(wb, &v, &c).unwrap_or(Turn::ZERO);
             split.middles[split.len] = (c, b);
             split.len += 1;
         }
@@ -390,7 +393,12 @@ pub(crate) fn triangle_placements(
     elbow: &Vector3,
     wrist: &Vector3,
 ) -> Result<Few<(Real, Matrix3), 2>, KinematicsError> {
-    placements_of(&robot.structure, wrist_zero, elbow, wrist)
+    let placements = placements_of(&robot.structure, wrist_zero, elbow, wrist)?;
+    let mut out = Few::new((0.0, Matrix3::zeros()));
+    for (q4, r123) in placements {
+        out.push((q4.angle, r123));
+    }
+    Ok(out)
 }
 
 /// [`triangle_placements`] for the arm structure `s`.
@@ -399,7 +407,7 @@ fn placements_of(
     wrist_zero: &Vector3,
     elbow: &Vector3,
     wrist: &Vector3,
-) -> Result<Few<(Real, Matrix3), 2>, KinematicsError> {
+) -> Result<Few<(Turn, Matrix3), 2>, KinematicsError> {
     let (w, p) = (&s.axes_zero, &s.axis_points_zero);
     let d = wrist.norm();
 
@@ -422,13 +430,13 @@ fn placements_of(
             max: lu + lf,
         });
     }
-    let mut placements = Few::new((0.0, Matrix3::zeros()));
+    let mut placements = Few::new((Turn::ZERO, Matrix3::zeros()));
     for q4 in q4s {
-        let (s4, c4) = q4.sin_cos();
-        let wrist_moved = c0 + c4 * v_perp + s4 * w_perp;
+        let turn = Turn::of(q4);
+        let wrist_moved = c0 + turn.cos * v_perp + turn.sin * w_perp;
         let r123 = align(&s.elbow_zero, &wrist_moved, elbow, wrist)
             .ok_or(KinematicsError::Singular(Singularity::StraightArm))?;
-        placements.push((q4, r123));
+        placements.push((turn, r123));
     }
     Ok(placements)
 }
@@ -455,7 +463,7 @@ fn branches_with_wrist(
 fn elbow_branches(
     robot: &Robot,
     s: &ArmStructure,
-    q4: Real,
+    q4: Turn,
     r123: &Matrix3,
     ow: &Rotation3,
     near: &JointVector,
@@ -464,10 +472,11 @@ fn elbow_branches(
     let w = &s.axes_zero;
     // Whatever the shoulder branch, R1 R2 R3 = r123: the wrist's share of
     // Ow is the same for both, so it is split once per q4.
-    let r567 = (r123 * rotation_about(&w[3], q4)).transpose()
+    let r567 = (r123 * rotation_from_sin_cos(&w[3], q4.sin, q4.cos)).transpose()
         * ow.matrix()
         * s.hand_zero.matrix().transpose();
     let wrists = decompose(&r567, &w[4], &w[5], &w[6], near[4])?;
+    let q4 = q4.angle;
     for &[q1, q2, q3] in decompose(r123, &w[0], &w[1], &w[2], near[0])?.as_slice() {
         for [q5, q6, q7] in wrists.as_slice() {
             let q = JointVector::from_column_slice(&[q1, q2, q3, q4, *q5, *q6, *q7]);
@@ -544,6 +553,7 @@ fn nearest_branch(
     let mut order = [0, 1];
     let order = &mut order[..placements.len()];
     if let [(a, _), (b, _)] = placements[..] {
+        let (a, b) = (a.angle, b.angle);
         if wrap_angle(a - b).abs() <= 1e-6 {
             return Ok(None);
         }
@@ -566,13 +576,14 @@ fn nearest_branch(
     let mut branches = Vec::with_capacity(8);
     let mut kept: Vec<JointVector> = Vec::with_capacity(8);
     for &mut g in order {
-        let (q4, r123) = placements[g];
+        let (turn, r123) = placements[g];
+        let q4 = turn.angle;
         if best.is_some_and(|(d, ..)| bound(q4) > d) {
             continue;
         }
         // Whatever the shoulder branch, R1 R2 R3 = r123: the wrist's share of Ow is the same
         // for both, so it is split once per q4 (as in `elbow_branches`).
-        let r567 = (r123 * rotation_about(&w[3], q4)).transpose()
+        let r567 = (r123 * rotation_from_sin_cos(&w[3], turn.sin, turn.cos)).transpose()
             * ow.matrix()
             * s.hand_zero.matrix().transpose();
         let wrists = Split::new(&r567, &w[4], &w[5], &w[6], near[4])?;
