@@ -287,7 +287,7 @@ pub(crate) fn decompose(
 /// A three-axis decomposition in two stages: each solution's middle angle first (which
 /// bounds its distance from a configuration), its outer angles when asked. The same
 /// arithmetic as [`decompose`], which runs both stages.
-struct Split<'a> {
+pub(crate) struct Split<'a> {
     wa: &'a Vector3,
     wb: &'a Vector3,
     wc: &'a Vector3,
@@ -299,11 +299,11 @@ struct Split<'a> {
     near_a: Real,
     /// Per solution, Rot(wb, b) wc and the middle turn b.
     middles: [(Vector3, Turn); 2],
-    len: usize,
+    pub(crate) len: usize,
 }
 
 impl<'a> Split<'a> {
-    fn new(
+    pub(crate) fn new(
         r: &Matrix3,
         wa: &'a Vector3,
         wb: &'a Vector3,
@@ -342,12 +342,12 @@ impl<'a> Split<'a> {
     }
 
     /// The middle angle of solution `i`.
-    fn middle(&self, i: usize) -> Real {
+    pub(crate) fn middle(&self, i: usize) -> Real {
         self.middles[i].1.angle
     }
 
     /// Solution `i`: (a, b, c).
-    fn solution(&self, i: usize) -> [Real; 3] {
+    pub(crate) fn solution(&self, i: usize) -> [Real; 3] {
         let (c, b) = &self.middles[i];
         let a = rotation_turn(self.wa, c, &self.w).unwrap_or_else(|| Turn::of(self.near_a));
         // Rot(wc, c) probe = Rot(wb, -b) Rot(wa, -a) R probe.
@@ -386,17 +386,18 @@ pub(crate) fn analytic_branches(
 }
 
 /// Every q4 that gives the triangle S-E-W the target's shape, with the
-/// rotation R1 R2 R3 that then places it on the target E and W.
+/// rotation R1 R2 R3 that then places it on the target E and W, and R1 R2 R3 R4.
 pub(crate) fn triangle_placements(
     robot: &Robot,
     wrist_zero: &Vector3,
     elbow: &Vector3,
     wrist: &Vector3,
-) -> Result<Few<(Real, Matrix3), 2>, KinematicsError> {
+) -> Result<Few<(Real, Matrix3, Matrix3), 2>, KinematicsError> {
     let placements = placements_of(&robot.structure, wrist_zero, elbow, wrist)?;
-    let mut out = Few::new((0.0, Matrix3::zeros()));
+    let mut out = Few::new((0.0, Matrix3::zeros(), Matrix3::zeros()));
     for (q4, r123) in placements {
-        out.push((q4.angle, r123));
+        let r1234 = r123 * rotation_from_sin_cos(&robot.structure.axes_zero[3], q4.sin, q4.cos);
+        out.push((q4.angle, r123, r1234));
     }
     Ok(out)
 }

@@ -12,7 +12,7 @@
 //! decides it, per group, since q4 does not depend on θ.
 
 use super::error::KinematicsError;
-use super::ik::{decompose, triangle_placements};
+use super::ik::{Split, triangle_placements};
 use super::spaces::{CpsaState, cpsa_to_hat, hat_points};
 use crate::math::{
     Few, Matrix3, PI, Real, Rotation3, Vector3, projector, rotation_about, skew, solve_trig,
@@ -90,14 +90,20 @@ impl Group<'_> {
         out
     }
 
-    /// Whether some solution of the group at θ lies within its limits.
+    /// Whether some solution of the group at θ lies within its limits. A solution's middle
+    /// angle comes first: one outside its limits is not finished (its outer angles cost two
+    /// more turns each).
     fn feasible_at(&self, theta: Real, near_a: Real) -> bool {
         let [wa, wb, wc] = self.axes;
-        decompose(&self.rotation.at(theta), wa, wb, wc, near_a)
-            .map(|sols| {
-                sols.as_slice().iter().any(|s| (0..3).all(|i| angle_within(self.limits[i], s[i])))
-            })
-            .unwrap_or(false)
+        let Ok(split) = Split::new(&self.rotation.at(theta), wa, wb, wc, near_a) else {
+            return false;
+        };
+        (0..split.len).any(|i| {
+            angle_within(self.limits[1], split.middle(i)) && {
+                let [a, _, c] = split.solution(i);
+                angle_within(self.limits[0], a) && angle_within(self.limits[2], c)
+            }
+        })
     }
 
     /// The feasible θ as sorted disjoint intervals of [-π, π].
@@ -175,7 +181,7 @@ pub fn swivel_intervals(
     // does not depend on θ), so each q4 branch contributes the intersection
     // of the two groups' feasible sets.
     let mut feasible = Vec::new();
-    for (q4, r0) in triangle_placements(robot, &s.wrist_zero, &elbow0, &wrist)? {
+    for (q4, r0, r1234) in triangle_placements(robot, &s.wrist_zero, &elbow0, &wrist)? {
         if !angle_within(limit(3), q4) {
             continue;
         }
@@ -184,7 +190,7 @@ pub fn swivel_intervals(
             axes: [&w[0], &w[1], &w[2]],
             limits: [limit(0), limit(1), limit(2)],
         };
-        let r1234t = (r0 * rotation_about(&w[3], q4)).transpose();
+        let r1234t = r1234.transpose();
         let wrist_group = Group {
             rotation: TrigMatrix {
                 a: r1234t * projector(&x) * hand,
