@@ -31,24 +31,72 @@ const JACOBIAN: usize = kinematics::JACOBIAN_VALUES;
 /// some 25 µs of work, well over the few microseconds a hand-over to another thread costs.
 const PARALLEL_ROWS: usize = 256;
 
-/// `run(first_row, rows of q, rows of out)` over all of `q` and `out` (`per_row` values an
-/// output row), as two halves at once when there are [`PARALLEL_ROWS`] rows or more (the cut
-/// on a multiple of the kernel's lanes); each half's answer, the first half's first (the
-/// second is always there when the batch was split: the scope waits for it).
-fn in_halves<R: Send>(
+/// Output rows a batch writes, which [`in_halves`] cuts in two at a row.
+trait Split: Sized {
+    /// The number of whole rows.
+    fn rows(&self) -> usize;
+    /// The first `row` rows and the rest.
+    fn split_at_row(self, row: usize) -> (Self, Self);
+}
+
+/// One output array: `per_row` values a row.
+struct Slots<'a> {
+    values: &'a mut [Real],
+    per_row: usize,
+}
+
+impl Split for Slots<'_> {
+    fn rows(&self) -> usize {
+        self.values.len() / self.per_row.max(1)
+    }
+
+    fn split_at_row(self, row: usize) -> (Self, Self) {
+        let (a, b) = self.values.split_at_mut(row * self.per_row);
+        (Slots { values: a, per_row: self.per_row }, Slots { values: b, per_row: self.per_row })
+    }
+}
+
+/// The three arrays of `cpsa_many`, written in place: pw (3 a row), ow (9, row-major) and the
+/// swivel angle (1).
+struct CpsaSlots<'a> {
+    pw: &'a mut [Real],
+    ow: &'a mut [Real],
+    swivel: &'a mut [Real],
+}
+
+impl Split for CpsaSlots<'_> {
+    fn rows(&self) -> usize {
+        (self.pw.len() / 3).min(self.ow.len() / 9).min(self.swivel.len())
+    }
+
+    fn split_at_row(self, row: usize) -> (Self, Self) {
+        let (pw_a, pw_b) = self.pw.split_at_mut(3 * row);
+        let (ow_a, ow_b) = self.ow.split_at_mut(9 * row);
+        let (swivel_a, swivel_b) = self.swivel.split_at_mut(row);
+        (
+            CpsaSlots { pw: pw_a, ow: ow_a, swivel: swivel_a },
+            CpsaSlots { pw: pw_b, ow: ow_b, swivel: swivel_b },
+        )
+    }
+}
+
+/// `run(first_row, rows of q, rows of out)` over all of `q` and `out`, as two halves at once
+/// when there are [`PARALLEL_ROWS`] rows or more (the cut on a multiple of the kernel's
+/// lanes); each half's answer, the first half's first (the second is always there when the
+/// batch was split: the scope waits for it).
+fn in_halves<R: Send, O: Split + Send>(
     q: &[Real],
     q_per_row: usize,
-    out: &mut [Real],
-    per_row: usize,
-    run: impl Fn(usize, &[Real], &mut [Real]) -> R + Sync,
+    out: O,
+    run: impl Fn(usize, &[Real], O) -> R + Sync,
 ) -> [Option<R>; 2] {
-    let rows = (q.len() / q_per_row.max(1)).min(out.len() / per_row.max(1));
+    let rows = (q.len() / q_per_row.max(1)).min(out.rows());
     if rows < PARALLEL_ROWS {
         return [Some(run(0, q, out)), None];
     }
     let half = (rows / 2).next_multiple_of(kinematics::LANES);
     let (q_a, q_b) = q.split_at(half * q_per_row);
-    let (out_a, out_b) = out.split_at_mut(half * per_row);
+    let (out_a, out_b) = out.split_at_row(half);
     // The calling thread runs the first half itself (rayon::join from outside the pool would
     // hand both halves over and wait), a thread of the pool the second.
     let mut second = None;
@@ -267,7 +315,9 @@ impl PyRobot {
         let (values, slots) = (rows.values(), slots(&mut guard));
         let per_row = row.iter().product();
         py.detach(|| {
-            in_halves(values, DOF, slots, per_row, |_, q, out| kernel(&self.chain, q, out))
+            in_halves(values, DOF, Slots { values: slots, per_row }, |_, q, out| {
+                kernel(&self.chain, q, out.values)
+            })
         });
         drop(guard);
         Ok(result)
@@ -334,26 +384,25 @@ impl PyRobot {
         let (mut pw_guard, mut ow_guard, mut swivel_guard) =
             (writer(&pw, "pw")?, writer(&ow, "ow")?, writer(&swivel, "swivel")?);
         let values = rows.values();
-        let (pw_out, ow_out, swivel_out) =
-            (slots(&mut pw_guard), slots(&mut ow_guard), slots(&mut swivel_guard));
-        // One output row: pw (3), ow (9) and the swivel angle, split into the three arrays
-        // below; the first failing row is reported.
-        const ROW: usize = 13;
-        let mut states = vec![0.0; n * ROW];
+        let outputs = CpsaSlots {
+            pw: slots(&mut pw_guard),
+            ow: slots(&mut ow_guard),
+            swivel: slots(&mut swivel_guard),
+        };
+        // Each row written straight into the three arrays; the first failing row is reported.
         let halves = py.detach(|| {
-            in_halves(values, DOF, &mut states, ROW, |first, q, out| {
+            in_halves(values, DOF, outputs, |first, q, out| {
                 let mut failed = None;
                 self.chain.cpsa_states(&self.robot, q, |i, state| match state {
                     Ok(s) if failed.is_none() => {
-                        let out = &mut out[ROW * i..ROW * i + ROW];
-                        out[..3].copy_from_slice(s.pw.as_slice());
-                        let r = s.ow.matrix();
+                        out.pw[3 * i..3 * i + 3].copy_from_slice(s.pw.as_slice());
+                        let (r, ow) = (s.ow.matrix(), &mut out.ow[9 * i..9 * i + 9]);
                         for a in 0..3 {
                             for b in 0..3 {
-                                out[3 + 3 * a + b] = r[(a, b)];
+                                ow[3 * a + b] = r[(a, b)];
                             }
                         }
-                        out[12] = s.swivel;
+                        out.swivel[i] = s.swivel;
                     }
                     Ok(_) => {}
                     Err(e) => {
@@ -365,15 +414,6 @@ impl PyRobot {
         });
         if let Some((row, e)) = halves.into_iter().flatten().flatten().next() {
             return Err(row_error(py, row, e));
-        }
-        for ((state, pw), (ow, swivel)) in states
-            .chunks_exact(ROW)
-            .zip(pw_out.chunks_exact_mut(3))
-            .zip(ow_out.chunks_exact_mut(9).zip(swivel_out.iter_mut()))
-        {
-            pw.copy_from_slice(&state[..3]);
-            ow.copy_from_slice(&state[3..12]);
-            *swivel = state[12];
         }
         drop((pw_guard, ow_guard, swivel_guard));
         Ok((pw, ow, swivel))
@@ -440,8 +480,8 @@ impl PyRobot {
         let near_values = near_rows.as_ref().map(|r| r.values());
         // The first failing row of each half; the first half's first.
         let halves = py.detach(|| {
-            in_halves(pw, 3, out, DOF, |first, _, out| {
-                for (q, i) in out.chunks_exact_mut(DOF).zip(first..) {
+            in_halves(pw, 3, Slots { values: out, per_row: DOF }, |first, _, out| {
+                for (q, i) in out.values.chunks_exact_mut(DOF).zip(first..) {
                     let target = CpsaState {
                         pw: Vector3::from_column_slice(&pw[3 * i..3 * i + 3]),
                         ow: rotations[i],
