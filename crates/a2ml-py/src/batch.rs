@@ -392,24 +392,8 @@ impl PyRobot {
         // Each row written straight into the three arrays; the first failing row is reported.
         let halves = py.detach(|| {
             in_halves(values, DOF, outputs, |first, q, out| {
-                let mut failed = None;
-                self.chain.cpsa_states(&self.robot, q, |i, state| match state {
-                    Ok(s) if failed.is_none() => {
-                        out.pw[3 * i..3 * i + 3].copy_from_slice(s.pw.as_slice());
-                        let (r, ow) = (s.ow.matrix(), &mut out.ow[9 * i..9 * i + 9]);
-                        for a in 0..3 {
-                            for b in 0..3 {
-                                ow[3 * a + b] = r[(a, b)];
-                            }
-                        }
-                        out.swivel[i] = s.swivel;
-                    }
-                    Ok(_) => {}
-                    Err(e) => {
-                        failed.get_or_insert((first + i, e));
-                    }
-                });
-                failed
+                let failed = self.chain.cpsa_values(&self.robot, q, out.pw, out.ow, out.swivel);
+                failed.map(|(row, e)| (first + row, e))
             })
         });
         if let Some((row, e)) = halves.into_iter().flatten().flatten().next() {
