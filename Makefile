@@ -30,7 +30,7 @@ $(VENV)/.tools-installed: $(PY_REQS)
 	$(VPY) -m pip install --quiet --disable-pip-version-check -r $(PY_REQS)
 	touch $@
 
-# Build the abi3 wheel (cp39-abi3) and install it into the venv, as a user's
+# Build the abi3 wheel (cp310-abi3) and install it into the venv, as a user's
 # `pip install` would.
 $(VENV)/.wheel-installed: $(VENV)/.tools-installed $(PY_INPUTS)
 	rm -f $(WHEEL_DIR)/a2ml-*.whl

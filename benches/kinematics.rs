@@ -100,6 +100,12 @@ fn batched(c: &mut Criterion) {
         group.bench_function("cpsa_states", |b| {
             b.iter(|| chain.cpsa_states(&robot, black_box(&q), |_, s| drop(black_box(s))))
         });
+        // cpsa_many's kernel: the states written as values.
+        let (mut pw, mut ow, mut swivel) =
+            (vec![0.0; 3 * BATCH], vec![0.0; 9 * BATCH], vec![0.0; BATCH]);
+        group.bench_function("cpsa_values", |b| {
+            b.iter(|| chain.cpsa_values(&robot, black_box(&q), &mut pw, &mut ow, &mut swivel))
+        });
         group.bench_function("arm_pose_loop_hand+J_ge", |b| {
             b.iter(|| {
                 for row in black_box(&q).chunks_exact(7) {

@@ -227,7 +227,8 @@ def test_threads_share_a_batch() -> None:
     np.testing.assert_array_equal(np.concatenate(results), expected)
 
 
-# A batch of 256 rows or more is cut in two halves run on two threads (src/batch.rs).
+# A batch of 256 rows or more is shared out in chunks of 64 rows between two threads
+# (src/batch.rs): 601 rows are ten chunks, the last a short one.
 LARGE = 601
 
 
@@ -253,21 +254,21 @@ def test_a_large_batch_split_over_threads_gives_the_bits_of_small_batches(name: 
     assert np.all(frames[:, 3, 3] == 1.0) and np.all(np.abs(jacobians[:, 3:]).sum(axis=1) > 0)
 
 
-def test_a_large_batch_reports_its_first_failing_row_whichever_half_it_is_in() -> None:
+def test_a_large_batch_reports_its_first_failing_row_whichever_chunk_it_is_in() -> None:
     r = robot("iiwa14")
     qs = configurations(r, LARGE, seed=6)
     pw, ow, swivel = r.cpsa_many(qs)
     far = pw.copy()
-    far[[450, 580]] *= 10.0  # both in the second half
+    far[[450, 580]] *= 10.0  # in two later chunks
     with pytest.raises(UnreachableError, match="^row 450: "):
         r.ik_cpsa_many(far, ow, swivel, qs)
-    far[17] *= 10.0  # and one in the first
+    far[17] *= 10.0  # and one in the first chunk
     with pytest.raises(UnreachableError, match="^row 17: "):
         r.ik_cpsa_many(far, ow, swivel, qs)
     solved = r.ik_cpsa_many(far, ow, swivel, qs, on_error="nan")
     assert np.isnan(solved[[17, 450, 580]]).all() and not np.isnan(np.delete(solved, [17, 450, 580], 0)).any()
     straight = qs.copy()
-    straight[[400, 500], 3] = 0.0  # the elbow straight in the second half
+    straight[[400, 500], 3] = 0.0  # the elbow straight in two later chunks
     with pytest.raises(SingularityError, match="^row 400: "):
         r.cpsa_many(straight)
     straight[3, 3] = 0.0

@@ -5,10 +5,10 @@
 //! float64 arrays in place (any other array-like is converted once), write into arrays the
 //! caller passes (`out=`) or into one array made for the result, and run the rows with the
 //! GIL released, by the core's batched kernel (`kinematics::BatchedChain`: several rows side by
-//! side). A batch of at least [`PARALLEL_ROWS`] rows is cut in two halves run at once on
-//! rayon's pool (the machine's cores): a row's result never depends on the other rows, so the
-//! bits are the same as on one thread; a smaller batch runs on the calling thread, where the
-//! hand-over would cost more than it saves.
+//! side). A batch of at least [`PARALLEL_ROWS`] rows is shared out in chunks between the
+//! calling thread and a thread of rayon's pool (two cores at once): a row's result never
+//! depends on the other rows, so the bits are the same as on one thread; a smaller batch runs
+//! on the calling thread, where the hand-over would cost more than it saves.
 
 use a2ml_core::kinematics::{self, ArmPose, BatchedChain, CpsaState, KinematicsError};
 use a2ml_core::math::{DOF, Jacobian6x7, JointVector, Matrix3, Real, Vector3};
@@ -31,32 +31,105 @@ const JACOBIAN: usize = kinematics::JACOBIAN_VALUES;
 /// some 25 µs of work, well over the few microseconds a hand-over to another thread costs.
 const PARALLEL_ROWS: usize = 256;
 
-/// `run(first_row, rows of q, rows of out)` over all of `q` and `out` (`per_row` values an
-/// output row), as two halves at once when there are [`PARALLEL_ROWS`] rows or more (the cut
-/// on a multiple of the kernel's lanes); each half's answer, the first half's first (the
-/// second is always there when the batch was split: the scope waits for it).
-fn in_halves<R: Send>(
+/// Output rows a batch writes, which [`in_chunks`] cuts at a row.
+trait Split: Sized {
+    /// The number of whole rows.
+    fn rows(&self) -> usize;
+    /// The first `row` rows and the rest.
+    fn split_at_row(self, row: usize) -> (Self, Self);
+}
+
+/// One output array: `per_row` values a row.
+struct Slots<'a> {
+    values: &'a mut [Real],
+    per_row: usize,
+}
+
+impl Split for Slots<'_> {
+    fn rows(&self) -> usize {
+        self.values.len() / self.per_row.max(1)
+    }
+
+    fn split_at_row(self, row: usize) -> (Self, Self) {
+        let (a, b) = self.values.split_at_mut(row * self.per_row);
+        (Slots { values: a, per_row: self.per_row }, Slots { values: b, per_row: self.per_row })
+    }
+}
+
+/// The three arrays of `cpsa_many`, written in place: pw (3 a row), ow (9, row-major) and the
+/// swivel angle (1).
+struct CpsaSlots<'a> {
+    pw: &'a mut [Real],
+    ow: &'a mut [Real],
+    swivel: &'a mut [Real],
+}
+
+impl Split for CpsaSlots<'_> {
+    fn rows(&self) -> usize {
+        (self.pw.len() / 3).min(self.ow.len() / 9).min(self.swivel.len())
+    }
+
+    fn split_at_row(self, row: usize) -> (Self, Self) {
+        let (pw_a, pw_b) = self.pw.split_at_mut(3 * row);
+        let (ow_a, ow_b) = self.ow.split_at_mut(9 * row);
+        let (swivel_a, swivel_b) = self.swivel.split_at_mut(row);
+        (
+            CpsaSlots { pw: pw_a, ow: ow_a, swivel: swivel_a },
+            CpsaSlots { pw: pw_b, ow: ow_b, swivel: swivel_b },
+        )
+    }
+}
+
+/// Rows a thread takes at a time from a split batch: a multiple of the kernel's lanes, some
+/// 4–8 µs of work, so the calling thread does not wait long for a thread of the pool that
+/// wakes late (tens of microseconds, measured: with two fixed halves a 1,000-row batch ran
+/// only 1.1–1.2× faster than on one thread).
+const CHUNK_ROWS: usize = 64;
+
+/// `run(first_row, rows of q, rows of out)` over all of `q` and `out`; each call's answer, in
+/// row order. Below [`PARALLEL_ROWS`] rows, one call on the calling thread; from there, the
+/// batch is cut into chunks of [`CHUNK_ROWS`] rows that the calling thread and one thread of
+/// rayon's pool take in turn until none is left (which thread runs a chunk changes nothing:
+/// a row's result never depends on the other rows).
+fn in_chunks<R: Send, O: Split + Send>(
     q: &[Real],
     q_per_row: usize,
-    out: &mut [Real],
-    per_row: usize,
-    run: impl Fn(usize, &[Real], &mut [Real]) -> R + Sync,
-) -> [Option<R>; 2] {
-    let rows = (q.len() / q_per_row.max(1)).min(out.len() / per_row.max(1));
+    out: O,
+    run: impl Fn(usize, &[Real], O) -> R + Sync,
+) -> Vec<R> {
+    let rows = (q.len() / q_per_row.max(1)).min(out.rows());
     if rows < PARALLEL_ROWS {
-        return [Some(run(0, q, out)), None];
+        return vec![run(0, q, out)];
     }
-    let half = (rows / 2).next_multiple_of(kinematics::LANES);
-    let (q_a, q_b) = q.split_at(half * q_per_row);
-    let (out_a, out_b) = out.split_at_mut(half * per_row);
-    // The calling thread runs the first half itself (rayon::join from outside the pool would
-    // hand both halves over and wait), a thread of the pool the second.
-    let mut second = None;
-    let first = rayon::in_place_scope(|scope| {
-        scope.spawn(|_| second = Some(run(half, q_b, out_b)));
-        run(0, q_a, out_a)
+    let (mut chunks, mut q, mut out) = (Vec::new(), q, out);
+    for first in (0..rows).step_by(CHUNK_ROWS) {
+        let size = CHUNK_ROWS.min(rows - first);
+        let (q_chunk, q_rest) = q.split_at(size * q_per_row);
+        let (out_chunk, out_rest) = out.split_at_row(size);
+        chunks.push((first, q_chunk, out_chunk));
+        (q, out) = (q_rest, out_rest);
+    }
+    let queue = std::sync::Mutex::new(chunks.into_iter());
+    // Chunks until the queue is empty, with their first rows.
+    let drain = || {
+        let mut done = Vec::new();
+        loop {
+            // A poisoned lock means the other thread panicked: its panic is the one reported.
+            let next = queue.lock().map(|mut chunks| chunks.next()).ok().flatten();
+            let Some((first, q, out)) = next else { return done };
+            done.push((first, run(first, q, out)));
+        }
+    };
+    // The calling thread works from the start (rayon::join from outside the pool would hand
+    // both sides over and wait); a thread of the pool joins when it wakes.
+    let mut helped = Vec::new();
+    let mut done = rayon::in_place_scope(|scope| {
+        scope.spawn(|_| helped = drain());
+        drain()
     });
-    [Some(first), second]
+    done.append(&mut helped);
+    done.sort_unstable_by_key(|(first, _)| *first);
+    done.into_iter().map(|(_, r)| r).collect()
 }
 
 /// A float64 n-dimensional numpy array.
@@ -267,7 +340,9 @@ impl PyRobot {
         let (values, slots) = (rows.values(), slots(&mut guard));
         let per_row = row.iter().product();
         py.detach(|| {
-            in_halves(values, DOF, slots, per_row, |_, q, out| kernel(&self.chain, q, out))
+            in_chunks(values, DOF, Slots { values: slots, per_row }, |_, q, out| {
+                kernel(&self.chain, q, out.values)
+            })
         });
         drop(guard);
         Ok(result)
@@ -334,46 +409,20 @@ impl PyRobot {
         let (mut pw_guard, mut ow_guard, mut swivel_guard) =
             (writer(&pw, "pw")?, writer(&ow, "ow")?, writer(&swivel, "swivel")?);
         let values = rows.values();
-        let (pw_out, ow_out, swivel_out) =
-            (slots(&mut pw_guard), slots(&mut ow_guard), slots(&mut swivel_guard));
-        // One output row: pw (3), ow (9) and the swivel angle, split into the three arrays
-        // below; the first failing row is reported.
-        const ROW: usize = 13;
-        let mut states = vec![0.0; n * ROW];
-        let halves = py.detach(|| {
-            in_halves(values, DOF, &mut states, ROW, |first, q, out| {
-                let mut failed = None;
-                self.chain.cpsa_states(&self.robot, q, |i, state| match state {
-                    Ok(s) if failed.is_none() => {
-                        let out = &mut out[ROW * i..ROW * i + ROW];
-                        out[..3].copy_from_slice(s.pw.as_slice());
-                        let r = s.ow.matrix();
-                        for a in 0..3 {
-                            for b in 0..3 {
-                                out[3 + 3 * a + b] = r[(a, b)];
-                            }
-                        }
-                        out[12] = s.swivel;
-                    }
-                    Ok(_) => {}
-                    Err(e) => {
-                        failed.get_or_insert((first + i, e));
-                    }
-                });
-                failed
+        let outputs = CpsaSlots {
+            pw: slots(&mut pw_guard),
+            ow: slots(&mut ow_guard),
+            swivel: slots(&mut swivel_guard),
+        };
+        // Each row written straight into the three arrays; the first failing row is reported.
+        let chunks = py.detach(|| {
+            in_chunks(values, DOF, outputs, |first, q, out| {
+                let failed = self.chain.cpsa_values(&self.robot, q, out.pw, out.ow, out.swivel);
+                failed.map(|(row, e)| (first + row, e))
             })
         });
-        if let Some((row, e)) = halves.into_iter().flatten().flatten().next() {
+        if let Some((row, e)) = chunks.into_iter().flatten().next() {
             return Err(row_error(py, row, e));
-        }
-        for ((state, pw), (ow, swivel)) in states
-            .chunks_exact(ROW)
-            .zip(pw_out.chunks_exact_mut(3))
-            .zip(ow_out.chunks_exact_mut(9).zip(swivel_out.iter_mut()))
-        {
-            pw.copy_from_slice(&state[..3]);
-            ow.copy_from_slice(&state[3..12]);
-            *swivel = state[12];
         }
         drop((pw_guard, ow_guard, swivel_guard));
         Ok((pw, ow, swivel))
@@ -438,10 +487,10 @@ impl PyRobot {
         let out = slots(&mut guard);
         let (pw, swivel) = (pw.values(), swivel.values());
         let near_values = near_rows.as_ref().map(|r| r.values());
-        // The first failing row of each half; the first half's first.
-        let halves = py.detach(|| {
-            in_halves(pw, 3, out, DOF, |first, _, out| {
-                for (q, i) in out.chunks_exact_mut(DOF).zip(first..) {
+        // The first failing row of each chunk, in row order.
+        let chunks = py.detach(|| {
+            in_chunks(pw, 3, Slots { values: out, per_row: DOF }, |first, _, out| {
+                for (q, i) in out.values.chunks_exact_mut(DOF).zip(first..) {
                     let target = CpsaState {
                         pw: Vector3::from_column_slice(&pw[3 * i..3 * i + 3]),
                         ow: rotations[i],
@@ -470,7 +519,7 @@ impl PyRobot {
                 None
             })
         });
-        if let Some((row, e)) = halves.into_iter().flatten().flatten().next() {
+        if let Some((row, e)) = chunks.into_iter().flatten().next() {
             return Err(row_error(py, row, e));
         }
         drop(guard);

@@ -269,6 +269,55 @@ impl BatchedChain {
         });
     }
 
+    /// The CPSA state of each row of `q`, as [`Self::cpsa_states`] gives it, written as values:
+    /// `pw` 3 a row, `ow` 9 a row (row-major), `swivel` 1 a row. A regular row is copied from
+    /// its lanes without making a [`CpsaState`]; the first failing row is returned with its
+    /// error, and no row after it is written.
+    pub fn cpsa_values(
+        &self,
+        robot: &Robot,
+        q: &[Real],
+        pw: &mut [Real],
+        ow: &mut [Real],
+        swivel: &mut [Real],
+    ) -> Option<(usize, KinematicsError)> {
+        let outputs = pw.chunks_exact_mut(3).zip(ow.chunks_exact_mut(9)).zip(swivel.iter_mut());
+        let mut failed = None;
+        self.each_group::<false, true, _>(q, outputs.enumerate(), |pose, lane, (row, out)| {
+            if failed.is_some() {
+                return;
+            }
+            let ((pw, ow), swivel) = out;
+            let hand = &pose.hand;
+            if let Some(angle) = pose.swivel[lane] {
+                for i in 0..3 {
+                    pw[i] = pose.wrist[i][lane];
+                    for j in 0..3 {
+                        ow[3 * i + j] = hand[i][j][lane];
+                    }
+                }
+                *swivel = angle;
+                return;
+            }
+            // Near a singularity: cpsa_from_points decides, by its own tolerances.
+            let point = |v: &LaneVector| Vector3::new(v[0][lane], v[1][lane], v[2][lane]);
+            let hand = Rotation3::from_matrix_unchecked(Matrix3::from_fn(|i, j| hand[i][j][lane]));
+            match cpsa_from_points(robot, &point(&pose.elbow), &point(&pose.wrist), hand) {
+                Ok(state) => {
+                    pw.copy_from_slice(state.pw.as_slice());
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            ow[3 * i + j] = state.ow[(i, j)];
+                        }
+                    }
+                    *swivel = state.swivel;
+                }
+                Err(e) => failed = Some((row, e)),
+            }
+        });
+        failed
+    }
+
     /// Runs `each(pose, lane, out)` for every row of `q` paired with an item of `outputs`,
     /// [`LANES`] rows at a time; a last short group repeats its last row in the spare lanes.
     ///
@@ -904,6 +953,52 @@ mod tests {
         chain.hand_frames(&q[..DOF + 3], &mut frames);
         assert!(frames[..FRAME_VALUES].iter().all(|v| v.is_finite()));
         assert!(frames[FRAME_VALUES..].iter().all(|v| v.is_nan()));
+    }
+
+    /// `cpsa_values` writes the bits `cpsa_states` gives, and stops at the first failing row.
+    #[test]
+    fn cpsa_values_are_the_bits_of_cpsa_states() {
+        let mut failures = 0;
+        for name in ROBOTS {
+            let robot = robot(name);
+            let chain = BatchedChain::new(&robot);
+            let rows = 3 * LANES + 2;
+            let mut q = configurations(&robot, rows);
+            let (mut pw, mut ow, mut swivel) =
+                (vec![Real::NAN; 3 * rows], vec![Real::NAN; 9 * rows], vec![Real::NAN; rows]);
+            assert!(chain.cpsa_values(&robot, &q, &mut pw, &mut ow, &mut swivel).is_none());
+            let mut seen = 0;
+            chain.cpsa_states(&robot, &q, |row, state| {
+                let state = state.expect("regular rows");
+                let ow_row: Vec<Real> = (0..9).map(|k| state.ow[(k / 3, k % 3)]).collect();
+                assert_eq!(pw[3 * row..3 * row + 3], *state.pw.as_slice(), "{name} {row}");
+                assert_eq!(ow[9 * row..9 * row + 9], ow_row[..], "{name} {row}");
+                assert_eq!(swivel[row].to_bits(), state.swivel.to_bits(), "{name} {row}");
+                seen += 1;
+            });
+            assert_eq!(seen, rows);
+            // A straight arm (the zero configuration) in row LANES + 1: that row's error, the
+            // rows before it written, none after.
+            let bad = LANES + 1;
+            q[DOF * bad..DOF * (bad + 1)].fill(0.0);
+            let mut expected = None;
+            chain.cpsa_states(&robot, &q, |row, state| {
+                if let (None, Err(e)) = (&expected, state) {
+                    expected = Some((row, e));
+                }
+            });
+            let (mut pw, mut ow, mut swivel) =
+                (vec![Real::NAN; 3 * rows], vec![Real::NAN; 9 * rows], vec![Real::NAN; rows]);
+            let failed = chain.cpsa_values(&robot, &q, &mut pw, &mut ow, &mut swivel);
+            assert_eq!(failed, expected, "{name}");
+            // An arm whose zero configuration is not singular writes every row.
+            let end = failed.as_ref().map_or(rows, |(row, _)| *row);
+            failures += usize::from(failed.is_some());
+            assert!(swivel[..end].iter().all(|v| v.is_finite()), "{name}");
+            assert!(swivel[end..].iter().all(|v| v.is_nan()), "{name}");
+            assert!(pw[3 * end..].iter().chain(&ow[9 * end..]).all(|v| v.is_nan()), "{name}");
+        }
+        assert!(failures > 0, "no arm was singular at its zero configuration");
     }
 
     #[test]
