@@ -1,13 +1,17 @@
 //! The seven MotionBenchMaker scenes (tests/data/mbm): rotated boxes and cylinders read into
 //! a scene, and joint-space RRT paths among them re-checked densely and independently.
 
-use a2ml::collision::{CollisionScene, min_distance};
+use a2ml::Robot;
+use a2ml::collision::{
+    CollisionModel, CollisionScene, Inflation, clearance, is_clear, min_distance, motion_bound,
+};
 use a2ml::kinematics::arm_pose;
 use a2ml::language::Shape;
-use a2ml::math::{Matrix3, Real};
+use a2ml::math::{JointVector, Matrix3, Real};
 use a2ml::solve::rrt::{RrtError, RrtOptions, rrt_connect};
+use rand::RngExt;
 
-use crate::common::load;
+use crate::common::{load, rng};
 use crate::mbm_problems::{SCENES, problems};
 
 #[test]
@@ -51,4 +55,66 @@ fn motion_bench_maker_paths_keep_the_clearance() {
         }
     }
     assert!(solved >= 14, "only {solved} of 28 problems solved");
+}
+
+/// The discrete edge check of the RRT is sound: on random edges in the MBM scenes, with both
+/// arm models and two clearances, an edge whose evenly spaced points all keep the clearance
+/// with every shape inflated by the farthest it moves over half their spacing ([`Inflation`])
+/// keeps it at 1000 points along it by the independent `min_distance`; and the uninflated
+/// check agrees with `clearance` at every point checked.
+#[test]
+fn edges_the_inflated_checks_call_clear_are_clear() {
+    let spheres = Robot::from_urdf_file(format!(
+        "{}/tests/data/panda_spheres/panda_spheres.urdf",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .expect("robot loads");
+    let mut rng = rng(22);
+    for (model_name, robot) in [("spheres", spheres), ("capsules", load("panda"))] {
+        let (lower, upper) = (robot.lower(), robot.upper());
+        for (s, scene_name) in SCENES.iter().enumerate() {
+            let problem = &problems(scene_name)[s];
+            let scene = CollisionScene::new(&problem.obstacles);
+            let model = CollisionModel::new(&robot, &scene);
+            let none = Inflation::none(&model);
+            let margin = if s % 2 == 0 { 0.0 } else { 0.01 };
+            let (mut proven, mut blocked) = (0, 0);
+            for _ in 0..1000 {
+                if proven >= 8 && blocked > 0 {
+                    break;
+                }
+                let a = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+                let towards = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+                let b = a + (towards - a) * rng.random_range(0.05..0.6);
+                let dq = b - a;
+                // Coarse spacings too, where an edge's points are far apart.
+                let spacing = [0.05, 0.2, 1.0, 4.0][rng.random_range(0..4)];
+                let n = (motion_bound(&model, &dq) / spacing).ceil().max(1.0) as usize;
+                let inflation = Inflation::along(&model, &dq, 0.5 / n as Real);
+                let mut clear = true;
+                for k in 0..=n {
+                    let q = a + dq * (k as Real / n as Real);
+                    let exact = clearance(&model, &q);
+                    let plain = is_clear(&model, &q, margin, &none);
+                    assert!(
+                        if plain { exact >= margin - 1e-9 } else { exact < margin + 1e-9 },
+                        "{model_name}/{scene_name}: is_clear {plain}, clearance {exact}"
+                    );
+                    clear &= is_clear(&model, &q, margin, &inflation);
+                }
+                if !clear {
+                    blocked += 1;
+                    continue;
+                }
+                proven += 1;
+                for k in 0..=1000 {
+                    let q = a + dq * (k as Real / 1000.0);
+                    let (d, link, o) =
+                        min_distance(&robot, &arm_pose(&robot, &q), &scene).expect("pairs");
+                    assert!(d >= margin - 1e-9, "{model_name}/{scene_name}: {link} {d} m from {o}");
+                }
+            }
+            assert!(proven > 0 && blocked > 0, "{model_name}/{scene_name}: {proven} {blocked}");
+        }
+    }
 }

@@ -4,7 +4,8 @@
 //! Entry points: [`CollisionScene::new`], [`arm_capsules`], [`distances`],
 //! [`min_distance`]; for many configurations of one scene (sampling
 //! planners), [`CollisionModel`] with [`clearance`], [`advancement`] (and
-//! [`advancement_at_least`]) and [`motion_bound`]; [`check_shapes`] before any query, so
+//! [`advancement_at_least`]) and [`motion_bound`], [`is_clear`] for a yes-or-no check with
+//! shapes inflated by an [`Inflation`]; [`check_shapes`] before any query, so
 //! that no pair is skipped for a shape parry cannot handle. Everything is in {b}, SI
 //! units. parry enters the crate here only; its glam types never leave this
 //! module.
@@ -25,7 +26,8 @@ mod model;
 
 pub use guard::{ShapeError, check_shapes};
 pub use model::{
-    CollisionModel, advancement, advancement_at_least, advancement_within, clearance, motion_bound,
+    CollisionModel, Inflation, advancement, advancement_at_least, advancement_within, clearance,
+    is_clear, motion_bound,
 };
 
 /// How much [`min_distance`] or [`clearance`] may differ from the exact

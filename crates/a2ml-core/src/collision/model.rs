@@ -16,6 +16,10 @@ use crate::math::{
 };
 use crate::robot::{LinkRole, Robot};
 
+mod clear;
+
+pub use clear::{Inflation, is_clear};
+
 /// The arm's capsules and a scene's obstacles, prepared for [`clearance`] and
 /// [`advancement`] at many configurations.
 ///

@@ -14,6 +14,7 @@
 //! within the velocity and acceleration limits: the motion is C² and stays on the edges the
 //! checks covered.
 
+use std::collections::VecDeque;
 use std::time::Instant;
 
 use rand::rngs::StdRng;
@@ -23,7 +24,8 @@ use super::monitor::Monitor;
 pub use super::timing::{LIMIT_FRACTION, TimedPath, shortest_bell, time_parameterise};
 use super::tree::{Tree, TreeSpace, connect_trees};
 use crate::collision::{
-    CollisionModel, CollisionScene, advancement_within, clearance, min_distance, motion_bound,
+    CollisionModel, CollisionScene, Inflation, advancement_within, clearance, is_clear,
+    min_distance, motion_bound,
 };
 use crate::kinematics::arm_pose;
 use crate::math::{JointVector, Real};
@@ -42,6 +44,12 @@ pub struct RrtOptions {
     /// stretch it closes), so checks are never closer than that, except next to a start or goal
     /// that itself shows less.
     pub resolution: Real,
+    /// Spacing of the discrete edge checks (m of arm motion), default 20 cm: an edge is first
+    /// checked at points this far apart with every shape inflated by the farthest it moves
+    /// over half of it (finer where an inflated shape comes within the clearance), which
+    /// proves a free edge free or finds a configuration of a blocked one within the
+    /// clearance; an edge they leave open is covered at [`RrtOptions::resolution`] instead.
+    pub spacing: Real,
     /// Distance kept from obstacles and between non-adjacent links (m), default 0.01.
     pub clearance: Real,
     /// Samples before giving up, default 20,000: what decides that a search failed.
@@ -59,6 +67,7 @@ impl Default for RrtOptions {
             seed: 0,
             step: 2.0,
             resolution: 0.005,
+            spacing: 0.2,
             clearance: 0.01,
             max_samples: 20_000,
             max_time: None,
@@ -268,6 +277,7 @@ pub(crate) fn check_options(o: &RrtOptions) -> Result<(), RrtError> {
     let checks = [
         (positive(o.step), "the step must be positive"),
         (positive(o.resolution), "the resolution must be positive"),
+        (positive(o.spacing), "the check spacing must be positive"),
         (o.clearance.is_finite() && o.clearance >= 0.0, "negative clearance"),
         (o.max_samples > 0, "no samples allowed"),
         (o.max_time.is_none_or(positive), "the time limit must be positive"),
@@ -286,6 +296,14 @@ struct JointSpace<'a> {
     model: CollisionModel,
     /// Uncovered stretches of the edge being checked (reused, to allocate once).
     gaps: Vec<Gap>,
+    /// The shapes' inflations for the discrete checks of the edge being checked (per halving
+    /// of their stretch), and none.
+    levels: Vec<Inflation>,
+    uninflated: Inflation,
+    /// Stretches (first, last check point) of the discrete checks still to split, and the
+    /// halved checks (parameter, halvings) still to make (reused).
+    stretches: VecDeque<(usize, usize)>,
+    halves: VecDeque<(Real, usize)>,
     checks: usize,
     /// When the search started, for its wall time.
     started: Instant,
@@ -310,7 +328,20 @@ impl<'a> JointSpace<'a> {
         model: CollisionModel,
     ) -> Self {
         let started = Instant::now();
-        Self { robot, scene, options, model, gaps: Vec::new(), checks: 0, started }
+        let uninflated = Inflation::none(&model);
+        Self {
+            robot,
+            scene,
+            options,
+            levels: Vec::new(),
+            uninflated,
+            model,
+            gaps: Vec::new(),
+            stretches: VecDeque::new(),
+            halves: VecDeque::new(),
+            checks: 0,
+            started,
+        }
     }
 
     /// Why `q` is not a valid end (within the limits, `clearance` from the scene), if it is not.
@@ -353,11 +384,17 @@ impl<'a> JointSpace<'a> {
     /// stretches are split finer until covered, down to a millionth of that). The ends must
     /// keep the clearance, a new `b` over half the resolution too, so that the edges leaving it
     /// are not that fine. So the whole edge keeps `clearance`.
+    ///
+    /// The discrete checks of [`JointSpace::discrete_edge`] decide most edges; only those they
+    /// leave open are covered this way.
     fn edge_free(&mut self, a: &JointVector, b: &JointVector, new: bool) -> bool {
         let dq = b - a;
         let travel = motion_bound(&self.model, &dq);
         if travel == 0.0 {
             return true;
+        }
+        if let Some(free) = self.discrete_edge(a, b, &dq, travel) {
+            return free;
         }
         // Half the resolution of arm motion, in units of the edge.
         let floor = 0.5 * self.options.resolution / travel;
@@ -397,6 +434,92 @@ impl<'a> JointSpace<'a> {
         true
     }
 }
+
+impl JointSpace<'_> {
+    /// Whether the edge a -> b (motion `dq`, no point of the arm moving farther than `travel`)
+    /// keeps the clearance, from discrete checks; `None` when they do not tell.
+    ///
+    /// A check at the edge's parameter t with every shape inflated by the farthest it moves
+    /// over h units of `dq` ([`Inflation::along`]: a capsule's levers times h|dq|, a self pair's
+    /// relative motion likewise) covers [t − h, t + h]: a distance between two sets changes by
+    /// no more than the farthest a point of either moves, so where the inflated shapes keep the
+    /// clearance at t, the shapes themselves keep it over that stretch. The edge is first
+    /// checked at n + 1 evenly spaced points, n = ⌈travel / spacing⌉, each covering 1/(2n)
+    /// either way (no point of the arm moves farther than spacing/2 over it), which together
+    /// cover the edge. A point that keeps the clearance only uninflated has its stretch
+    /// covered by two checks of half of it, down to [`REFINEMENTS`] halvings; a point that does
+    /// not keep the clearance even uninflated is a configuration of the edge within it, and
+    /// the edge is blocked. So `Some(true)` only when the checks cover the whole edge.
+    ///
+    /// The ends are checked first (b, the new one, before a), then the points between in
+    /// bisection order, and the halvings last, so that a blocked edge is found after few
+    /// checks.
+    fn discrete_edge(
+        &mut self,
+        a: &JointVector,
+        b: &JointVector,
+        dq: &JointVector,
+        travel: Real,
+    ) -> Option<bool> {
+        let n = (travel / self.options.spacing).ceil().max(1.0);
+        let half = 0.5 / n;
+        let n = n as usize;
+        // The inflations of the halvings are made when first needed.
+        let mut levels = 0;
+        self.stretches.clear();
+        self.stretches.push_back((0, n));
+        self.halves.clear();
+        let mut ends = [n, 0].into_iter();
+        loop {
+            let (t, level) = if let Some(k) = ends.next() {
+                (k as Real / n as Real, 0)
+            } else if let Some((first, last)) = self.stretches.pop_front() {
+                if last - first < 2 {
+                    continue;
+                }
+                let middle = first + (last - first) / 2;
+                self.stretches.push_back((first, middle));
+                self.stretches.push_back((middle, last));
+                (middle as Real / n as Real, 0)
+            } else if let Some(half) = self.halves.pop_front() {
+                half
+            } else {
+                return Some(true);
+            };
+            while levels <= level {
+                let h = half / (1 << levels) as Real;
+                match self.levels.get_mut(levels) {
+                    Some(inflation) => inflation.set_along(&self.model, dq, h),
+                    None => self.levels.push(Inflation::along(&self.model, dq, h)),
+                }
+                levels += 1;
+            }
+            let q = if t == 1.0 { *b } else { a + dq * t };
+            self.checks += 1;
+            if is_clear(&self.model, &q, self.options.clearance, &self.levels[level]) {
+                continue;
+            }
+            self.checks += 1;
+            if !is_clear(&self.model, &q, self.options.clearance, &self.uninflated) {
+                return Some(false);
+            }
+            if level == REFINEMENTS {
+                return None;
+            }
+            // The two halves of [t − h, t + h]; at an end, the one outside the edge is not.
+            let h = half / (1 << level) as Real;
+            for t in [t - 0.5 * h, t + 0.5 * h] {
+                if (0.0..=1.0).contains(&t) {
+                    self.halves.push_back((t, level + 1));
+                }
+            }
+        }
+    }
+}
+
+/// How many times a discrete check's stretch is halved where its inflated shapes come within
+/// the clearance, before the edge is left to the covering checks.
+const REFINEMENTS: usize = 3;
 
 /// A node of a joint-space tree: its configuration, and for a goal tree's root which goal it
 /// is.

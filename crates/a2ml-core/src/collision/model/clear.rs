@@ -1,0 +1,200 @@
+//! [`is_clear`]: whether every pair of a [`CollisionModel`] keeps a clearance at one
+//! configuration, each shape inflated by an [`Inflation`]: a yes-or-no answer that stops at the
+//! first pair too close and computes no distance it does not need, for the discrete edge checks
+//! of sampling planners.
+
+use super::{Centers, CollisionModel, GROUP_SIZE, Posed, ROUNDING};
+use crate::math::{DOF, JointVector, Real, segment_segment_distance};
+
+/// How much each shape of a [`CollisionModel`] is inflated in [`is_clear`] (m): per arm capsule,
+/// per self pair (the two capsules' relative motion) and per group of them, the largest of
+/// their members'.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Inflation {
+    links: Vec<Real>,
+    groups: Vec<Real>,
+    /// Per capsule and first joint s, Σ_{j≥s} its lever_j · s |dq_j|: a self pair's inflation
+    /// is its distal capsule's from the pair's first joint on (its levers are the distal's over
+    /// the joints between the two frames, and a capsule's are zero past its frame).
+    suffixes: Vec<[Real; DOF]>,
+    group_pairs: Vec<Real>,
+}
+
+impl Inflation {
+    /// No inflation: [`is_clear`] then asks whether every pair keeps the clearance itself.
+    pub fn none(model: &CollisionModel) -> Self {
+        let arm = &model.arm;
+        Self {
+            links: vec![0.0; arm.links.len()],
+            groups: vec![0.0; arm.groups.len()],
+            suffixes: vec![[0.0; DOF]; arm.links.len()],
+            group_pairs: vec![0.0; arm.group_pairs.len()],
+        }
+    }
+
+    /// The farthest each shape moves (relative to the other capsule, for a self pair) over `s`
+    /// units of the straight joint-space motion `dq`, from any configuration: its levers
+    /// ([`super::motion_bound`]) times `s |dq|`.
+    pub fn along(model: &CollisionModel, dq: &JointVector, s: Real) -> Self {
+        let mut inflation = Self::none(model);
+        inflation.set_along(model, dq, s);
+        inflation
+    }
+
+    /// [`Inflation::along`] in place, for `model` (the one it was made for).
+    pub fn set_along(&mut self, model: &CollisionModel, dq: &JointVector, s: Real) {
+        let arm = &model.arm;
+        let speed = dq.abs() * s;
+        let fill = |out: &mut Vec<Real>, levers: &mut dyn Iterator<Item = &JointVector>| {
+            out.clear();
+            out.extend(levers.map(|l| l.dot(&speed)));
+        };
+        fill(&mut self.links, &mut arm.links.iter().map(|l| &l.levers));
+        fill(&mut self.groups, &mut arm.groups.iter().map(|g| &g.levers));
+        fill(&mut self.group_pairs, &mut arm.group_pairs.iter().map(|p| &p.levers));
+        self.suffixes.clear();
+        self.suffixes.extend(arm.links.iter().map(|link| {
+            let mut suffix = [0.0; DOF];
+            let mut sum = 0.0;
+            for j in (0..DOF).rev() {
+                sum += link.levers[j] * speed[j];
+                suffix[j] = sum * RAISE;
+            }
+            suffix
+        }));
+    }
+}
+
+/// Over 7 terms of one sign, rounding moves a sum by far less than this: a suffix sum is never
+/// below the pair's own dot product of its levers.
+const RAISE: Real = 1.0 + 64.0 * Real::EPSILON;
+
+impl Inflation {
+    fn pair(&self, distal: usize, start: usize) -> Real {
+        self.suffixes[distal][start]
+    }
+}
+
+/// Whether, with the arm at `q`, every pair of [`super::min_distance`] is at least `clearance`
+/// (m) apart once each shape is inflated by `inflation`: an arm capsule against an obstacle by
+/// the capsule's, a self pair by the pair's. Stops at the first pair that is not.
+///
+/// Every test is a lower bound of the pair's distance (bounding spheres, closed forms, the
+/// tangent bound of a segment against a box or cylinder), so a `true` is never wrong; a `false`
+/// may come from a pair within [`super::SEGMENT_TOLERANCE`] of the bound.
+pub fn is_clear(
+    model: &CollisionModel,
+    q: &JointVector,
+    clearance: Real,
+    inflation: &Inflation,
+) -> bool {
+    let arm = &*model.arm;
+    let frames = arm.chain.frames(q);
+    // Distances are compared with this raised by a shape's inflation (and its radius).
+    let limit = clearance + ROUNDING;
+    for (g, group) in arm.groups.iter().enumerate() {
+        let center = frames[group.frame].apply(&group.center);
+        let near = limit + inflation.groups[g] + group.bound;
+        let mut posed: [Option<Posed>; GROUP_SIZE] = Default::default();
+        let place = |m: usize| arm.links[group.members[m]].posed(&frames);
+        // What a member's segment (its core) must keep from an obstacle's surface.
+        let keep = |m: usize| {
+            let i = group.members[m];
+            limit + inflation.links[i] + arm.links[i].radius
+        };
+        for sphere in &model.spheres {
+            let reach = near + sphere.radius;
+            if (center - sphere.center).norm_squared() >= reach * reach {
+                continue;
+            }
+            for (m, slot) in posed.iter_mut().enumerate().take(group.members.len()) {
+                let reach = keep(m) + sphere.radius;
+                let link = slot.get_or_insert_with(|| place(m));
+                if link.squared_distance_to_point(&sphere.center) < reach * reach {
+                    return false;
+                }
+            }
+        }
+        for capsule in &model.capsules {
+            let gap = (center - 0.5 * (capsule.a + capsule.b)).norm()
+                - 0.5 * (capsule.b - capsule.a).norm()
+                - capsule.radius;
+            if gap >= near {
+                continue;
+            }
+            for (m, slot) in posed.iter_mut().enumerate().take(group.members.len()) {
+                let link = slot.get_or_insert_with(|| place(m));
+                let distance = segment_segment_distance(&link.a, &link.b, &capsule.a, &capsule.b);
+                if distance < keep(m) + capsule.radius {
+                    return false;
+                }
+            }
+        }
+        for convex in &model.convex {
+            let body = &convex.body;
+            if (center - body.center).norm() - body.bound >= near
+                || convex.point_distance(&center) >= near
+            {
+                continue;
+            }
+            for (m, slot) in posed.iter_mut().enumerate().take(group.members.len()) {
+                let link = slot.get_or_insert_with(|| place(m));
+                let keep = keep(m);
+                let half_length = link.bound - link.radius;
+                if (link.center - body.center).norm() - half_length - body.bound >= keep {
+                    continue;
+                }
+                let close = if link.inverse_squared_length == 0.0 {
+                    convex.point_distance(&link.a) < keep
+                } else {
+                    convex.point_distance(&link.center) - half_length < keep
+                        && convex.segment_distance(&link.a, &link.b, keep).is_some()
+                };
+                if close {
+                    return false;
+                }
+            }
+        }
+    }
+    let group_center = |g: usize| {
+        arm.groups.get(g).map(|group| (frames[group.frame].apply(&group.center), group.bound))
+    };
+    // A capsule is in many self pairs: its bounding sphere's centre placed once.
+    let mut centers = Centers::new();
+    for (gp, group_pair) in arm.group_pairs.iter().enumerate() {
+        let keep = limit + inflation.group_pairs[gp];
+        // Sorted by floor within the group pair: the pairs from here on keep it at every
+        // configuration.
+        if group_pair.floor >= keep {
+            continue;
+        }
+        if let (Some((ca, ba)), Some((cb, bb))) =
+            (group_center(group_pair.groups.0), group_center(group_pair.groups.1))
+        {
+            if (ca - cb).norm() - ba - bb >= keep {
+                continue;
+            }
+        }
+        for k in group_pair.pairs.clone() {
+            let pair = &arm.hot[k];
+            if pair.floor >= keep {
+                break;
+            }
+            let keep = limit + inflation.pair(pair.distal, pair.start);
+            if pair.floor >= keep {
+                continue;
+            }
+            let reach = keep + pair.bounds;
+            let gap = centers.get(pair.link, &arm.links, &frames)
+                - centers.get(pair.other, &arm.links, &frames);
+            if gap.norm_squared() >= reach * reach {
+                continue;
+            }
+            let (link, other) = (&arm.links[pair.link], &arm.links[pair.other]);
+            if link.posed(&frames).distance(&other.posed(&frames)) < keep {
+                return false;
+            }
+        }
+    }
+    true
+}
