@@ -496,9 +496,9 @@ fn swivels(elbow: &LaneVector, wrist: &LaneVector, vertical: &Vector3) -> [Optio
 fn atan2(y: &Lane, x: &Lane) -> Lane {
     const ATAN_HIGH: [Real; 4] = [
         4.636_476_090_008_060_935_15e-1,
-        7.853_981_633_974_482_789_99e-1,
+        std::f64::consts::FRAC_PI_4,
         9.827_937_232_473_290_540_82e-1,
-        1.570_796_326_794_896_558_00,
+        std::f64::consts::FRAC_PI_2,
     ];
     const ATAN_LOW: [Real; 4] = [
         2.269_877_745_296_168_709_24e-17,
@@ -818,6 +818,7 @@ mod tests {
 
     #[test]
     fn sines_and_cosines_agree_with_the_platform_to_an_ulp_or_two() {
+        let mut worst: Real = 0.0;
         for i in -200_000..=200_000 {
             let x = i as Real * 2.5e-4 + 1e-7 * (i % 7) as Real;
             let (s, c) = reduced_sin_cos(&[x; LANES]);
@@ -1040,7 +1041,6 @@ mod tests {
             let unit = (state >> 11) as Real / (1u64 << 53) as Real;
             values.push(10.0_f64.powf(12.0 * unit - 6.0) * if state & 1 == 0 { 1.0 } else { 2.5 });
         }
-        let mut worst: Real = 0.0;
         for (n, &y) in values.iter().enumerate() {
             let x = values[(n * 7 + 3) % values.len()];
             for (y, x) in [(y, x), (-y, x), (y, -x), (-y, -x), (x, y)] {
