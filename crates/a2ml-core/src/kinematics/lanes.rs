@@ -13,7 +13,7 @@
 
 use super::error::KinematicsError;
 use super::spaces::{CpsaState, cpsa_from_points};
-use crate::math::{DOF, Matrix3, Real, Rotation3, Vector3};
+use crate::math::{DOF, Matrix3, PI, Real, Rotation3, Vector3};
 
 const FRAC_2_PI: Real = std::f64::consts::FRAC_2_PI;
 use crate::robot::Robot;
@@ -483,7 +483,76 @@ fn swivels(elbow: &LaneVector, wrist: &LaneVector, vertical: &Vector3) -> [Optio
         // Written so that a NaN is not regular.
         regular[l] = plane >= REGULAR && m_norm >= REGULAR;
     }
-    std::array::from_fn(|l| regular[l].then(|| a[l].atan2(b[l])))
+    let angle = atan2(&a, &b);
+    std::array::from_fn(|l| regular[l].then_some(angle[l]))
+}
+
+/// atan2(y, x) of each lane by fdlibm's atan polynomial, side by side: |y|/|x| is reduced to
+/// one of fdlibm's five ranges in a single division of its |y| and |x| combination (not
+/// fdlibm's bits, within a few ulps of them), then put in its quadrant. A lane with y and x
+/// both zero, or not finite, is left to the platform's atan2.
+#[allow(clippy::excessive_precision)] // fdlibm's digits as published: the same doubles.
+#[inline(always)]
+fn atan2(y: &Lane, x: &Lane) -> Lane {
+    const ATAN_HIGH: [Real; 4] = [
+        4.636_476_090_008_060_935_15e-1,
+        std::f64::consts::FRAC_PI_4,
+        9.827_937_232_473_290_540_82e-1,
+        std::f64::consts::FRAC_PI_2,
+    ];
+    const ATAN_LOW: [Real; 4] = [
+        2.269_877_745_296_168_709_24e-17,
+        3.061_616_997_868_383_017_93e-17,
+        1.390_331_103_123_099_845_16e-17,
+        6.123_233_995_736_766_035_87e-17,
+    ];
+    const AT: [Real; 11] = [
+        3.333_333_333_333_293_180_27e-1,
+        -1.999_999_999_987_648_324_76e-1,
+        1.428_571_427_250_346_637_11e-1,
+        -1.111_111_040_546_235_578_80e-1,
+        9.090_887_133_436_506_561_96e-2,
+        -7.691_876_205_044_829_994_95e-2,
+        6.661_073_137_387_531_206_69e-2,
+        -5.833_570_133_790_573_486_45e-2,
+        4.976_877_994_615_932_360_17e-2,
+        -3.653_157_274_421_691_552_70e-2,
+        1.628_582_011_536_578_236_23e-2,
+    ];
+    const PI_LOW: Real = 1.224_646_799_147_353_177_2e-16;
+    let mut out = [0.0; LANES];
+    for l in 0..LANES {
+        let (a, b) = (y[l].abs(), x[l].abs());
+        // t = a / b, reduced as fdlibm's atan does: t, (2t - 1)/(2 + t), (t - 1)/(t + 1),
+        // (t - 1.5)/(1 + 1.5t) or -1/t by its range, each written over a and b.
+        let (id, num, den) = if a < 0.4375 * b {
+            (None, a, b)
+        } else if a < 0.6875 * b {
+            (Some(0), 2.0 * a - b, 2.0 * b + a)
+        } else if a < 1.1875 * b {
+            (Some(1), a - b, a + b)
+        } else if a < 2.4375 * b {
+            (Some(2), a - 1.5 * b, b + 1.5 * a)
+        } else {
+            (Some(3), -b, a)
+        };
+        let t = num / den;
+        let z = t * t;
+        let w = z * z;
+        let s1 = z * (AT[0] + w * (AT[2] + w * (AT[4] + w * (AT[6] + w * (AT[8] + w * AT[10])))));
+        let s2 = w * (AT[1] + w * (AT[3] + w * (AT[5] + w * (AT[7] + w * AT[9]))));
+        let angle = match id {
+            None => t - t * (s1 + s2),
+            Some(i) => ATAN_HIGH[i] - ((t * (s1 + s2) - ATAN_LOW[i]) - t),
+        };
+        let angle = if x[l].is_sign_negative() { PI - (angle - PI_LOW) } else { angle };
+        out[l] = if (a > 0.0 || b > 0.0) && a.is_finite() && b.is_finite() {
+            angle.copysign(y[l])
+        } else {
+            y[l].atan2(x[l])
+        };
+    }
+    out
 }
 
 /// `m` turned about its z column by the angle of (sin, cos) in each lane: `m Rz(θ)`.
@@ -956,6 +1025,45 @@ mod tests {
     }
 
     /// `cpsa_values` writes the bits `cpsa_states` gives, and stops at the first failing row.
+    #[test]
+    fn lane_atan2_is_within_a_few_ulps_of_the_platforms() {
+        // Every quadrant, signed zeros, ratios from 1e-300 to 1e300 and each side of every
+        // range boundary of the reduction.
+        let mut values = vec![0.0, -0.0, 1e-300, 1e300, Real::INFINITY, Real::NAN];
+        for boundary in [0.4375, 0.6875, 1.1875, 2.4375, 1.0] {
+            for step in -3..=3 {
+                values.push(boundary * (1.0 + Real::from(step) * 1e-15));
+            }
+        }
+        let mut state: u64 = 0x9e37_79b9_7f4a_7c15;
+        for _ in 0..4000 {
+            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            let unit = (state >> 11) as Real / (1u64 << 53) as Real;
+            values.push(10.0_f64.powf(12.0 * unit - 6.0) * if state & 1 == 0 { 1.0 } else { 2.5 });
+        }
+        for (n, &y) in values.iter().enumerate() {
+            let x = values[(n * 7 + 3) % values.len()];
+            for (y, x) in [(y, x), (-y, x), (y, -x), (-y, -x), (x, y)] {
+                let lanes = atan2(&[y; LANES], &[x; LANES]);
+                let platform = y.atan2(x);
+                for angle in lanes {
+                    if platform.is_nan() {
+                        assert!(angle.is_nan(), "atan2({y}, {x}) = {angle}, not NaN");
+                        continue;
+                    }
+                    let ulps = (angle - platform).abs()
+                        / (platform.abs().max(Real::MIN_POSITIVE) * Real::EPSILON);
+                    assert!(ulps <= 4.0, "atan2({y}, {x}) = {angle}, the platform's {platform}");
+                    assert_eq!(
+                        angle.is_sign_negative(),
+                        platform.is_sign_negative(),
+                        "atan2({y}, {x})"
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn cpsa_values_are_the_bits_of_cpsa_states() {
         let mut failures = 0;
