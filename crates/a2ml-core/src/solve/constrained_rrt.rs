@@ -39,7 +39,7 @@ use super::chart::{MAX_GAIN, MAX_JUMP, MIN_STEP, SAME_BRANCH};
 use super::monitor::Monitor;
 use super::rrt::{RrtError, RrtOptions, RrtStats};
 pub use super::timing::time_constrained;
-use super::tree::{Tree, TreeSpace, connect_trees};
+use super::tree::{Growth, Tree, TreeSpace, connect_trees};
 use crate::collision::{CollisionModel, CollisionScene, advancement, clearance, motion_bound};
 use crate::math::{JointVector, Real};
 use crate::robot::Robot;
@@ -125,6 +125,8 @@ pub fn constrained_rrt_monitored(
         from_goal,
         &mut rng,
         options.max_samples,
+        // The chart's own growth as the paper's: its snapshots and figures are of it.
+        Growth::PLAIN,
         &mut monitor,
     )?;
     let path = connected.path.iter().map(|n| (n.x, n.q)).collect();

@@ -22,7 +22,8 @@ use rand::{RngExt, SeedableRng};
 
 use super::monitor::Monitor;
 pub use super::timing::{LIMIT_FRACTION, TimedPath, shortest_bell, time_parameterise};
-use super::tree::{Tree, TreeSpace, connect_trees};
+pub use super::tree::DynamicDomain;
+use super::tree::{Growth, Tree, TreeSpace, connect_trees};
 use crate::collision::{
     CollisionModel, CollisionScene, Inflation, advancement_within, clearance, is_clear,
     min_distance, motion_bound,
@@ -59,6 +60,12 @@ pub struct RrtOptions {
     pub max_time: Option<Real>,
     /// Shortcut attempts on the found path, default 200.
     pub shortcuts: usize,
+    /// Each node's sampling domain in joint space ([`DynamicDomain`], VAMP's settings by
+    /// default); `None` takes every sample, as the plain RRT-Connect does.
+    pub dynamic_domain: Option<DynamicDomain>,
+    /// Grow the smaller tree while the other has at least twice its nodes, default true;
+    /// false: the trees take turns.
+    pub balance: bool,
 }
 
 impl Default for RrtOptions {
@@ -72,6 +79,8 @@ impl Default for RrtOptions {
             max_samples: 20_000,
             max_time: None,
             shortcuts: 200,
+            dynamic_domain: Some(DynamicDomain::default()),
+            balance: true,
         }
     }
 }
@@ -264,6 +273,7 @@ fn search(
         from_goal,
         &mut rng,
         options.max_samples,
+        Growth { domain: options.dynamic_domain, balance: options.balance },
         &mut monitor,
     )?;
     let goal = connected.path.last().and_then(|n| n.goal).unwrap_or(0);
@@ -281,6 +291,15 @@ pub(crate) fn check_options(o: &RrtOptions) -> Result<(), RrtError> {
         (o.clearance.is_finite() && o.clearance >= 0.0, "negative clearance"),
         (o.max_samples > 0, "no samples allowed"),
         (o.max_time.is_none_or(positive), "the time limit must be positive"),
+        (
+            o.dynamic_domain.is_none_or(|d| {
+                positive(d.radius)
+                    && positive(d.min_radius)
+                    && d.min_radius <= d.radius
+                    && (0.0..1.0).contains(&d.alpha)
+            }),
+            "the dynamic domain needs radii with 0 < min_radius <= radius and 0 <= alpha < 1",
+        ),
     ];
     match checks.iter().find(|(ok, _)| !ok) {
         Some((_, reason)) => Err(RrtError::InvalidOptions { reason }),
