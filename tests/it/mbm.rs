@@ -3,7 +3,8 @@
 
 use a2ml::Robot;
 use a2ml::collision::{
-    CollisionModel, CollisionScene, Inflation, clearance, is_clear, min_distance, motion_bound,
+    CollisionModel, CollisionScene, Inflation, Verdict, clearance, is_clear, min_distance,
+    motion_bound, verdict,
 };
 use a2ml::kinematics::arm_pose;
 use a2ml::language::Shape;
@@ -60,8 +61,9 @@ fn motion_bench_maker_paths_keep_the_clearance() {
 /// The discrete edge check of the RRT is sound: on random edges in the MBM scenes, with both
 /// arm models and two clearances, an edge whose evenly spaced points all keep the clearance
 /// with every shape inflated by the farthest it moves over half their spacing ([`Inflation`])
-/// keeps it at 1000 points along it by the independent `min_distance`; and the uninflated
-/// check agrees with `clearance` at every point checked.
+/// keeps it at 1000 points along it by the independent `min_distance`; the uninflated
+/// check agrees with `clearance` at every point checked, and the one-pass `verdict` with the
+/// two checks.
 #[test]
 fn edges_the_inflated_checks_call_clear_are_clear() {
     let spheres = Robot::from_urdf_file(format!(
@@ -100,7 +102,19 @@ fn edges_the_inflated_checks_call_clear_are_clear() {
                         if plain { exact >= margin - 1e-9 } else { exact < margin + 1e-9 },
                         "{model_name}/{scene_name}: is_clear {plain}, clearance {exact}"
                     );
-                    clear &= is_clear(&model, &q, margin, &inflation);
+                    let inflated = is_clear(&model, &q, margin, &inflation);
+                    // The one-pass verdict answers both questions as the two checks do.
+                    let expected = match (inflated, plain) {
+                        (true, _) => Verdict::Clear,
+                        (false, true) => Verdict::Tight,
+                        (false, false) => Verdict::Blocked,
+                    };
+                    assert_eq!(
+                        verdict(&model, &q, margin, &inflation),
+                        expected,
+                        "{model_name}/{scene_name}: the verdict at {q:?}"
+                    );
+                    clear &= inflated;
                 }
                 if !clear {
                     blocked += 1;

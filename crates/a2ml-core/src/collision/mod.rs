@@ -5,7 +5,8 @@
 //! [`min_distance`]; for many configurations of one scene (sampling
 //! planners), [`CollisionModel`] with [`clearance`], [`advancement`] (and
 //! [`advancement_at_least`]) and [`motion_bound`], [`is_clear`] for a yes-or-no check with
-//! shapes inflated by an [`Inflation`]; [`check_shapes`] before any query, so
+//! shapes inflated by an [`Inflation`] ([`verdict`]: with and without it in one pass);
+//! [`check_shapes`] before any query, so
 //! that no pair is skipped for a shape parry cannot handle. Everything is in {b}, SI
 //! units. parry enters the crate here only; its glam types never leave this
 //! module.
@@ -26,8 +27,8 @@ mod model;
 
 pub use guard::{ShapeError, check_shapes};
 pub use model::{
-    CollisionModel, Inflation, advancement, advancement_at_least, advancement_within, clearance,
-    is_clear, motion_bound,
+    CollisionModel, Inflation, Verdict, advancement, advancement_at_least, advancement_within,
+    clearance, is_clear, motion_bound, verdict,
 };
 
 /// How much [`min_distance`] or [`clearance`] may differ from the exact

@@ -18,7 +18,7 @@ use crate::robot::{LinkRole, Robot};
 
 mod clear;
 
-pub use clear::{Inflation, is_clear};
+pub use clear::{Inflation, Verdict, is_clear, verdict};
 
 /// The arm's capsules and a scene's obstacles, prepared for [`clearance`] and
 /// [`advancement`] at many configurations.

@@ -25,8 +25,8 @@ pub use super::timing::{LIMIT_FRACTION, TimedPath, shortest_bell, time_parameter
 pub use super::tree::DynamicDomain;
 use super::tree::{Growth, Tree, TreeSpace, connect_trees};
 use crate::collision::{
-    CollisionModel, CollisionScene, Inflation, advancement_within, clearance, is_clear,
-    min_distance, motion_bound,
+    CollisionModel, CollisionScene, Inflation, Verdict, advancement_within, clearance,
+    min_distance, motion_bound, verdict,
 };
 use crate::kinematics::arm_pose;
 use crate::math::{JointVector, Real};
@@ -316,9 +316,8 @@ struct JointSpace<'a> {
     /// Uncovered stretches of the edge being checked (reused, to allocate once).
     gaps: Vec<Gap>,
     /// The shapes' inflations for the discrete checks of the edge being checked (per halving
-    /// of their stretch), and none.
+    /// of their stretch).
     levels: Vec<Inflation>,
-    uninflated: Inflation,
     /// Stretches (first, last check point) of the discrete checks still to split, and the
     /// halved checks (parameter, halvings) still to make (reused).
     stretches: VecDeque<(usize, usize)>,
@@ -347,13 +346,11 @@ impl<'a> JointSpace<'a> {
         model: CollisionModel,
     ) -> Self {
         let started = Instant::now();
-        let uninflated = Inflation::none(&model);
         Self {
             robot,
             scene,
             options,
             levels: Vec::new(),
-            uninflated,
             model,
             gaps: Vec::new(),
             stretches: VecDeque::new(),
@@ -470,9 +467,10 @@ impl JointSpace<'_> {
     /// not keep the clearance even uninflated is a configuration of the edge within it, and
     /// the edge is blocked. So `Some(true)` only when the checks cover the whole edge.
     ///
-    /// The ends are checked first (b, the new one, before a), then the points between in
-    /// bisection order, and the halvings last, so that a blocked edge is found after few
-    /// checks.
+    /// The new end b is checked first (the likelier to collide), then the points between in
+    /// bisection order, then a (where the edge leaves the tree: clear itself, so only what its
+    /// check covers is in question), and the halvings last, so that a blocked edge is found
+    /// after few checks.
     fn discrete_edge(
         &mut self,
         a: &JointVector,
@@ -488,10 +486,10 @@ impl JointSpace<'_> {
         self.stretches.clear();
         self.stretches.push_back((0, n));
         self.halves.clear();
-        let mut ends = [n, 0].into_iter();
+        let (mut end_b, mut end_a) = (true, true);
         loop {
-            let (t, level) = if let Some(k) = ends.next() {
-                (k as Real / n as Real, 0)
+            let (t, level) = if std::mem::take(&mut end_b) {
+                (1.0, 0)
             } else if let Some((first, last)) = self.stretches.pop_front() {
                 if last - first < 2 {
                     continue;
@@ -500,6 +498,8 @@ impl JointSpace<'_> {
                 self.stretches.push_back((first, middle));
                 self.stretches.push_back((middle, last));
                 (middle as Real / n as Real, 0)
+            } else if std::mem::take(&mut end_a) {
+                (0.0, 0)
             } else if let Some(half) = self.halves.pop_front() {
                 half
             } else {
@@ -514,13 +514,13 @@ impl JointSpace<'_> {
                 levels += 1;
             }
             let q = if t == 1.0 { *b } else { a + dq * t };
+            // One pass tells both whether the inflated shapes keep the clearance and, where
+            // not, whether the shapes themselves do.
             self.checks += 1;
-            if is_clear(&self.model, &q, self.options.clearance, &self.levels[level]) {
-                continue;
-            }
-            self.checks += 1;
-            if !is_clear(&self.model, &q, self.options.clearance, &self.uninflated) {
-                return Some(false);
+            match verdict(&self.model, &q, self.options.clearance, &self.levels[level]) {
+                Verdict::Clear => continue,
+                Verdict::Blocked => return Some(false),
+                Verdict::Tight => {}
             }
             if level == REFINEMENTS {
                 return None;

@@ -88,19 +88,74 @@ pub fn is_clear(
     clearance: Real,
     inflation: &Inflation,
 ) -> bool {
+    scan(model, q, clearance, inflation, false) == Verdict::Clear
+}
+
+/// What one pass over the pairs of a [`CollisionModel`] tells of a configuration
+/// ([`verdict`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verdict {
+    /// Every pair keeps the clearance with the shapes inflated.
+    Clear,
+    /// Every pair keeps the clearance, but not once inflated.
+    Tight,
+    /// A pair is within the clearance itself.
+    Blocked,
+}
+
+/// [`is_clear`] with `inflation` and without it in one pass: [`Verdict::Clear`] when
+/// `is_clear(model, q, clearance, inflation)`, else [`Verdict::Tight`] when
+/// `is_clear(model, q, clearance, &Inflation::none(model))`, else [`Verdict::Blocked`].
+///
+/// The pass stops at the first pair within the clearance itself; the first pair within it
+/// only inflated makes the rest of the pass test the shapes uninflated (the pairs before it
+/// kept the inflated clearance, so they keep the plain one). What a sampling planner's edge
+/// check asks at a point: covered, or a collision found, or neither yet.
+pub fn verdict(
+    model: &CollisionModel,
+    q: &JointVector,
+    clearance: Real,
+    inflation: &Inflation,
+) -> Verdict {
+    scan(model, q, clearance, inflation, true)
+}
+
+/// The pass of [`verdict`]; with `settle` false it stops at the first pair within the inflated
+/// clearance, answering [`Verdict::Blocked`] (not clear, without telling which way).
+fn scan(
+    model: &CollisionModel,
+    q: &JointVector,
+    clearance: Real,
+    inflation: &Inflation,
+    settle: bool,
+) -> Verdict {
     let arm = &*model.arm;
     let frames = arm.chain.frames(q);
     // Distances are compared with this raised by a shape's inflation (and its radius).
     let limit = clearance + ROUNDING;
+    // 1 while the shapes are inflated; 0 once a pair came within the inflated clearance and
+    // the rest of the pass looks for a pair within the plain one.
+    let mut scale: Real = 1.0;
+    // A pair at `distance` (a lower bound) below `keep`, the inflated clearance, whose plain
+    // clearance is `plain`: the pass ends (not settling, or a collision), or goes on uninflated.
+    macro_rules! violated {
+        ($distance:expr, $plain:expr) => {{
+            if !settle || $distance < $plain {
+                return Verdict::Blocked;
+            }
+            scale = 0.0;
+        }};
+    }
     for (g, group) in arm.groups.iter().enumerate() {
         let center = frames[group.frame].apply(&group.center);
-        let near = limit + inflation.groups[g] + group.bound;
+        let near = limit + inflation.groups[g] * scale + group.bound;
         let mut posed: [Option<Posed>; GROUP_SIZE] = Default::default();
         let place = |m: usize| arm.links[group.members[m]].posed(&frames);
-        // What a member's segment (its core) must keep from an obstacle's surface.
-        let keep = |m: usize| {
+        // What a member's segment (its core) must keep from an obstacle's surface: inflated
+        // (`scale` 1) or not.
+        let keep = |m: usize, scale: Real| {
             let i = group.members[m];
-            limit + inflation.links[i] + arm.links[i].radius
+            limit + inflation.links[i] * scale + arm.links[i].radius
         };
         for sphere in &model.spheres {
             let reach = near + sphere.radius;
@@ -108,10 +163,12 @@ pub fn is_clear(
                 continue;
             }
             for (m, slot) in posed.iter_mut().enumerate().take(group.members.len()) {
-                let reach = keep(m) + sphere.radius;
+                let reach = keep(m, scale) + sphere.radius;
                 let link = slot.get_or_insert_with(|| place(m));
-                if link.squared_distance_to_point(&sphere.center) < reach * reach {
-                    return false;
+                let squared = link.squared_distance_to_point(&sphere.center);
+                if squared < reach * reach {
+                    let plain = keep(m, 0.0) + sphere.radius;
+                    violated!(squared, plain * plain);
                 }
             }
         }
@@ -125,8 +182,8 @@ pub fn is_clear(
             for (m, slot) in posed.iter_mut().enumerate().take(group.members.len()) {
                 let link = slot.get_or_insert_with(|| place(m));
                 let distance = segment_segment_distance(&link.a, &link.b, &capsule.a, &capsule.b);
-                if distance < keep(m) + capsule.radius {
-                    return false;
+                if distance < keep(m, scale) + capsule.radius {
+                    violated!(distance, keep(m, 0.0) + capsule.radius);
                 }
             }
         }
@@ -139,19 +196,21 @@ pub fn is_clear(
             }
             for (m, slot) in posed.iter_mut().enumerate().take(group.members.len()) {
                 let link = slot.get_or_insert_with(|| place(m));
-                let keep = keep(m);
+                let inflated = keep(m, scale);
                 let half_length = link.bound - link.radius;
-                if (link.center - body.center).norm() - half_length - body.bound >= keep {
+                if (link.center - body.center).norm() - half_length - body.bound >= inflated {
                     continue;
                 }
+                // A lower bound of the segment's distance, when below the inflated clearance.
                 let close = if link.inverse_squared_length == 0.0 {
-                    convex.point_distance(&link.a) < keep
+                    Some(convex.point_distance(&link.a)).filter(|&d| d < inflated)
+                } else if convex.point_distance(&link.center) - half_length < inflated {
+                    convex.segment_distance(&link.a, &link.b, inflated)
                 } else {
-                    convex.point_distance(&link.center) - half_length < keep
-                        && convex.segment_distance(&link.a, &link.b, keep).is_some()
+                    None
                 };
-                if close {
-                    return false;
+                if let Some(distance) = close {
+                    violated!(distance, keep(m, 0.0));
                 }
             }
         }
@@ -162,7 +221,7 @@ pub fn is_clear(
     // A capsule is in many self pairs: its bounding sphere's centre placed once.
     let mut centers = Centers::new();
     for (gp, group_pair) in arm.group_pairs.iter().enumerate() {
-        let keep = limit + inflation.group_pairs[gp];
+        let keep = limit + inflation.group_pairs[gp] * scale;
         // Sorted by floor within the group pair: the pairs from here on keep it at every
         // configuration.
         if group_pair.floor >= keep {
@@ -177,10 +236,10 @@ pub fn is_clear(
         }
         for k in group_pair.pairs.clone() {
             let pair = &arm.hot[k];
-            if pair.floor >= keep {
+            if pair.floor >= limit + inflation.group_pairs[gp] * scale {
                 break;
             }
-            let keep = limit + inflation.pair(pair.distal, pair.start);
+            let keep = limit + inflation.pair(pair.distal, pair.start) * scale;
             if pair.floor >= keep {
                 continue;
             }
@@ -191,10 +250,11 @@ pub fn is_clear(
                 continue;
             }
             let (link, other) = (&arm.links[pair.link], &arm.links[pair.other]);
-            if link.posed(&frames).distance(&other.posed(&frames)) < keep {
-                return false;
+            let distance = link.posed(&frames).distance(&other.posed(&frames));
+            if distance < keep {
+                violated!(distance, limit);
             }
         }
     }
-    true
+    if scale == 1.0 { Verdict::Clear } else { Verdict::Tight }
 }
