@@ -197,14 +197,20 @@ fn scan(
             for (m, slot) in posed.iter_mut().enumerate().take(group.members.len()) {
                 let link = slot.get_or_insert_with(|| place(m));
                 let inflated = keep(m, scale);
+                // A lower bound of the segment's distance, when below the inflated clearance.
+                // A point's distance is as cheap as a bounding-sphere test, and exact.
+                if link.inverse_squared_length == 0.0 {
+                    let distance = convex.point_distance(&link.a);
+                    if distance < inflated {
+                        violated!(distance, keep(m, 0.0));
+                    }
+                    continue;
+                }
                 let half_length = link.bound - link.radius;
                 if (link.center - body.center).norm() - half_length - body.bound >= inflated {
                     continue;
                 }
-                // A lower bound of the segment's distance, when below the inflated clearance.
-                let close = if link.inverse_squared_length == 0.0 {
-                    Some(convex.point_distance(&link.a)).filter(|&d| d < inflated)
-                } else if convex.point_distance(&link.center) - half_length < inflated {
+                let close = if convex.point_distance(&link.center) - half_length < inflated {
                     convex.segment_distance(&link.a, &link.b, inflated)
                 } else {
                     None
