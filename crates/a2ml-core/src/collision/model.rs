@@ -433,6 +433,12 @@ impl Arm {
             }
         }
         let group_of = |capsule: usize| groups_of[capsule];
+        let mut slot_of = vec![0; links.len()];
+        for group in &groups {
+            for (m, &i) in group.members.iter().enumerate() {
+                slot_of[i] = m;
+            }
+        }
         // A base capsule never moves: it has no group, and stands for itself. Within a pair of
         // groups the lowest floor first, so that a check stops at the first floor too high.
         let key = |pair: &SelfPair| (group_of(pair.link), group_of(pair.other));
@@ -468,6 +474,7 @@ impl Arm {
             .map(|p| HotPair {
                 link: p.link,
                 other: p.other,
+                slots: (slot_of[p.link], slot_of[p.other]),
                 distal: p.distal,
                 start: p.joints.start,
                 bounds: p.bounds,
@@ -776,6 +783,9 @@ impl Rates {
 struct HotPair {
     link: usize,
     other: usize,
+    /// Where `link` and `other` are among their groups' members ([`Group::members`]; 0 for a
+    /// base capsule, which has no group).
+    slots: (usize, usize),
     distal: usize,
     /// The first joint between the two frames.
     start: usize,

@@ -4,7 +4,8 @@ use parry3d_f64::shape::Segment;
 use rand::{RngExt, SeedableRng};
 
 use super::*;
-use crate::collision::to_parry;
+use crate::collision::{min_distance, to_parry};
+use crate::kinematics::arm_pose;
 
 const TOL: Real = 1e-9;
 
@@ -396,6 +397,63 @@ fn a_model_with_another_scene_answers_as_a_new_one() {
             let (a, b) =
                 (advancement(&fresh, &q, &dq, 0.01), advancement(&prepared, &q, &dq, 0.01));
             assert_eq!(a.to_bits(), b.to_bits());
+        }
+    }
+}
+
+/// The one-pass verdict on the self pairs alone (no obstacles, where the members-near-the-
+/// other-group masks decide most pairs): uninflated, `Blocked` exactly where the independent
+/// `min_distance` is within the clearance; inflated along a motion, `Clear` only where every
+/// configuration the inflation covers keeps the clearance by `min_distance`, and always what
+/// `is_clear` says with and without the inflation.
+#[test]
+fn verdicts_on_self_pairs_match_the_independent_distance() {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(43);
+    for (r, robot) in floor_robots().iter().enumerate() {
+        let scene = CollisionScene::new(&[]);
+        let model = CollisionModel::new(robot, &scene);
+        let none = Inflation::none(&model);
+        let (lower, upper) = (robot.lower(), robot.upper());
+        let mut seen = [0; 3];
+        for k in 0..1500 {
+            let margin = if k % 2 == 0 { 0.0 } else { 0.01 };
+            let q = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+            let exact = min_distance(robot, &arm_pose(robot, &q), &scene)
+                .map_or(Real::INFINITY, |(d, _, _)| d);
+            let plain = verdict(&model, &q, margin, &none);
+            assert_ne!(plain, Verdict::Tight, "robot {r}: nothing is inflated");
+            if (exact - margin).abs() > 1e-9 {
+                assert_eq!(
+                    plain == Verdict::Blocked,
+                    exact < margin,
+                    "robot {r}: {plain:?} at {exact} m"
+                );
+            }
+            let dq = JointVector::from_fn(|_, _| rng.random_range(-1.0..1.0));
+            let s = rng.random_range(0.0..0.2);
+            let inflation = Inflation::along(&model, &dq, s);
+            let inflated = verdict(&model, &q, margin, &inflation);
+            let expected = if is_clear(&model, &q, margin, &inflation) {
+                Verdict::Clear
+            } else if is_clear(&model, &q, margin, &none) {
+                Verdict::Tight
+            } else {
+                Verdict::Blocked
+            };
+            assert_eq!(inflated, expected, "robot {r}");
+            seen[inflated as usize] += 1;
+            if inflated == Verdict::Clear {
+                for t in 0..=20 {
+                    let p = q + dq * (s * (t as Real / 10.0 - 1.0));
+                    let d = min_distance(robot, &arm_pose(robot, &p), &scene)
+                        .map_or(Real::INFINITY, |(d, _, _)| d);
+                    assert!(d >= margin - 1e-9, "robot {r}: {d} m within the covered motion");
+                }
+            }
+        }
+        // The spheres' self pairs come close often enough for every answer to occur.
+        if r == 0 {
+            assert!(seen.iter().all(|&n| n > 0), "verdicts seen {seen:?}");
         }
     }
 }
