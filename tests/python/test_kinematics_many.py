@@ -274,3 +274,36 @@ def test_a_large_batch_reports_its_first_failing_row_whichever_chunk_it_is_in() 
     straight[3, 3] = 0.0
     with pytest.raises(SingularityError, match="^row 3: "):
         r.cpsa_many(straight)
+
+
+def test_per_call_writes_beside_a_batch_in_another_thread() -> None:
+    """A per-call write into `out=` skips numpy's borrow table only while no batch of this
+    module runs detached; beside one it takes the tracked path: the same bits either way."""
+    r = robot("panda")
+    qs = configurations(r, 4000, seed=11)
+    expected_batch = r.jacobian_many(qs)
+    singles = qs[:300]
+    expected = [r.fk_jacobian(q) for q in singles]
+    done = threading.Event()
+    batches: list[NDArray[np.float64]] = []
+
+    def work() -> None:
+        while not done.is_set():
+            batches.append(r.jacobian_many(qs))
+
+    worker = threading.Thread(target=work)
+    worker.start()
+    frame_out, jacobian_out = np.empty((4, 4)), np.empty((6, 7))
+    try:
+        for _ in range(20):
+            for q, (frame, jacobian) in zip(singles, expected):
+                f, j = r.fk_jacobian(q, frame_out, jacobian_out)
+                assert f is frame_out and j is jacobian_out
+                np.testing.assert_array_equal(frame_out, frame)
+                np.testing.assert_array_equal(jacobian_out, jacobian)
+    finally:
+        done.set()
+        worker.join()
+    assert batches
+    for batch in batches:
+        np.testing.assert_array_equal(batch, expected_batch)

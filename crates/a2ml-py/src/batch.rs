@@ -12,12 +12,15 @@
 
 use a2ml_core::kinematics::{self, ArmPose, BatchedChain, CpsaState, KinematicsError};
 use a2ml_core::math::{DOF, Jacobian6x7, JointVector, Matrix3, Real, Vector3};
+use numpy::npyffi::{NPY_ARRAY_WRITEABLE, objects::_PyArray_GET_ITEM_DATA};
 use numpy::{
     AllowTypeChange, IntoPyArray, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyReadwriteArrayDyn,
     PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::marker::Ungil;
 use pyo3::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::convert::{not_numbers, read_joints, rotation_from, shape_text};
 use crate::errors::CoreError;
@@ -214,6 +217,63 @@ fn output<'py>(
     Ok(array.clone())
 }
 
+/// Calls of this module running with the GIL released while they hold borrows of numpy arrays
+/// (the batched ones, [`detached`]). While none does, a per-call write into an `out` array,
+/// made with the GIL held and no Python code running, overlaps no Rust borrow of this module,
+/// so it skips rust-numpy's borrow tracking (a shared table entered and left per array).
+/// Process-wide because the arrays are.
+static DETACHED: AtomicUsize = AtomicUsize::new(0);
+
+/// Counts a call in [`DETACHED`] while it lives.
+struct Detached;
+
+impl Detached {
+    fn enter() -> Self {
+        DETACHED.fetch_add(1, Ordering::SeqCst);
+        Self
+    }
+}
+
+impl Drop for Detached {
+    fn drop(&mut self) {
+        DETACHED.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// `f` with the GIL released, counted in [`DETACHED`]: every call of this module that holds
+/// numpy borrows while detached goes through here.
+fn detached<T: Ungil>(py: Python<'_>, f: impl Ungil + FnOnce() -> T) -> T {
+    let _counted = Detached::enter();
+    py.detach(f)
+}
+
+/// `values` copied into `array` (float64, C-contiguous, of their length: [`output`]'s), if it
+/// can be done without rust-numpy's borrow tracking: no detached call of this module running
+/// (none then holds a borrow of any array), the array writeable. False when not, and nothing
+/// is written. Another extension that writes or reads the array with the GIL released (as
+/// numpy's own loops may) is not seen, as it is not by rust-numpy either unless it uses it.
+#[allow(unsafe_code)]
+fn write_untracked(array: &Array<'_>, values: &[Real]) -> bool {
+    if DETACHED.load(Ordering::SeqCst) != 0 {
+        return false;
+    }
+    // SAFETY: the pointer is a live array's (the bound reference keeps it).
+    let flags = unsafe { (*_PyArray_GET_ITEM_DATA(array.as_array_ptr())).flags };
+    if flags & NPY_ARRAY_WRITEABLE == 0 {
+        return false;
+    }
+    // SAFETY: the GIL is held and no Python code runs before the copy ends, so no Python code
+    // touches the array meanwhile; no Rust borrow of it is live: this call holds none, and a
+    // call of this module holding one while detached would be counted in DETACHED.
+    match unsafe { array.as_slice_mut() } {
+        Ok(slots) if slots.len() == values.len() => {
+            slots.copy_from_slice(values);
+            true
+        }
+        _ => false,
+    }
+}
+
 /// Borrows `array` for writing; an `out` that is not writeable or shares memory with an input
 /// is refused.
 fn writer<'py>(array: &Array<'py>, name: &str) -> PyResult<PyReadwriteArrayDyn<'py, Real>> {
@@ -266,7 +326,9 @@ fn emit<'py>(
         return Ok(array.into_pyarray(py));
     }
     let array = output(py, out, name, shape)?;
-    slots(&mut writer(&array, name)?).copy_from_slice(values);
+    if !write_untracked(&array, values) {
+        slots(&mut writer(&array, name)?).copy_from_slice(values);
+    }
     Ok(array)
 }
 
@@ -339,7 +401,7 @@ impl PyRobot {
         let mut guard = writer(&result, "out")?;
         let (values, slots) = (rows.values(), slots(&mut guard));
         let per_row = row.iter().product();
-        py.detach(|| {
+        detached(py, || {
             in_chunks(values, DOF, Slots { values: slots, per_row }, |_, q, out| {
                 kernel(&self.chain, q, out.values)
             })
@@ -415,7 +477,7 @@ impl PyRobot {
             swivel: slots(&mut swivel_guard),
         };
         // Each row written straight into the three arrays; the first failing row is reported.
-        let chunks = py.detach(|| {
+        let chunks = detached(py, || {
             in_chunks(values, DOF, outputs, |first, q, out| {
                 let failed = self.chain.cpsa_values(&self.robot, q, out.pw, out.ow, out.swivel);
                 failed.map(|(row, e)| (first + row, e))
@@ -488,7 +550,7 @@ impl PyRobot {
         let (pw, swivel) = (pw.values(), swivel.values());
         let near_values = near_rows.as_ref().map(|r| r.values());
         // The first failing row of each chunk, in row order.
-        let chunks = py.detach(|| {
+        let chunks = detached(py, || {
             in_chunks(pw, 3, Slots { values: out, per_row: DOF }, |first, _, out| {
                 for (q, i) in out.values.chunks_exact_mut(DOF).zip(first..) {
                     let target = CpsaState {
