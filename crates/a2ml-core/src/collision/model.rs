@@ -695,17 +695,43 @@ impl CollisionModel {
             if group_pair.floor >= limit {
                 continue;
             }
-            if let (Some((ca, ba)), Some((cb, bb))) =
-                (bounding(group_pair.groups.0), bounding(group_pair.groups.1))
-            {
-                if (ca - cb).norm() - ba - bb - offset >= loose_pair.threshold(best) {
+            // Per group, its members near the other group's bounding sphere (bit m: member m),
+            // as in `is_clear`: a member far from the other's whole group cannot lower `best`.
+            let mut near = (u32::MAX, u32::MAX);
+            let (a, b) = group_pair.groups;
+            if let (Some((ca, ba)), Some((cb, bb))) = (bounding(a), bounding(b)) {
+                let threshold = loose_pair.threshold(best);
+                if (ca - cb).norm() - ba - bb - offset >= threshold {
                     continue;
+                }
+                let (members_a, members_b) =
+                    (&self.arm.groups[a].members, &self.arm.groups[b].members);
+                if group_pair.pairs.len() > members_a.len() + members_b.len() {
+                    let mut mask = |members: &[usize], center: &Vector3, bound: Real| {
+                        let mut bits = 0;
+                        for (m, &i) in members.iter().enumerate() {
+                            let gap = (centers.get(i, &self.arm.links, &frames) - center).norm();
+                            // A NaN threshold keeps the member: the pair loop decides.
+                            let far = gap - self.arm.links[i].bound - bound - offset >= threshold;
+                            if !far {
+                                bits |= 1 << m;
+                            }
+                        }
+                        bits
+                    };
+                    near = (mask(members_a, &cb, bb), mask(members_b, &ca, ba));
+                    if near.0 == 0 || near.1 == 0 {
+                        continue;
+                    }
                 }
             }
             for (k, pair) in self.arm.hot[group_pair.pairs.clone()].iter().enumerate() {
                 // Sorted by floor: the rest are higher still.
                 if pair.floor >= limit {
                     break;
+                }
+                if near.0 & (1 << pair.slots.0) == 0 || near.1 & (1 << pair.slots.1) == 0 {
+                    continue;
                 }
                 let levers = || &self.arm.self_pairs[group_pair.pairs.start + k].levers;
                 let loose = match (speed, &rates) {

@@ -457,3 +457,40 @@ fn verdicts_on_self_pairs_match_the_independent_distance() {
         }
     }
 }
+
+/// Clearance and advancement on the self pairs alone (no obstacles, where the members-near-the-
+/// other-group masks decide most pairs) against the independent `min_distance`: the clearance
+/// is its value, and an advancement keeps the clearance over the whole motion it allows.
+#[test]
+fn clearance_and_advancement_on_self_pairs_match_the_independent_distance() {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(47);
+    for (r, robot) in floor_robots().iter().enumerate() {
+        let scene = CollisionScene::new(&[]);
+        let model = CollisionModel::new(robot, &scene);
+        let (lower, upper) = (robot.lower(), robot.upper());
+        let distance = |q: &JointVector| {
+            min_distance(robot, &arm_pose(robot, q), &scene).map_or(Real::INFINITY, |(d, _, _)| d)
+        };
+        for k in 0..1000 {
+            let q = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+            let exact = distance(&q);
+            let fast = clearance(&model, &q);
+            assert!(
+                (fast - exact).abs() <= 1e-9 || (fast.is_infinite() && exact.is_infinite()),
+                "robot {r}, {k}: clearance {fast} against {exact}"
+            );
+            let offset = [0.0, 0.01][k % 2];
+            if exact < offset {
+                continue;
+            }
+            let dq = JointVector::from_fn(|_, _| rng.random_range(-1.0..1.0))
+                * rng.random_range(0.01..2.0);
+            let s = advancement(&model, &q, &dq, offset).min(1.0);
+            for t in 0..=20 {
+                let p = q + dq * (s * (t as Real / 10.0 - 1.0));
+                let d = distance(&p);
+                assert!(d >= offset - 1e-9, "robot {r}, {k}: {d} m within an advancement of {s}");
+            }
+        }
+    }
+}
