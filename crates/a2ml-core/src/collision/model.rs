@@ -56,6 +56,12 @@ struct Arm {
 /// the stack.
 const GROUP_SIZE: usize = 16;
 
+// A group's members are told apart by the bits of a u32 ([`Arm::near_members`]).
+const _: () = assert!(GROUP_SIZE <= 32);
+
+/// Every member of both groups of a group pair, as [`Arm::near_members`] gives them.
+const ALL_MEMBERS: (u32, u32) = (u32::MAX, u32::MAX);
+
 /// Capsules of one moving frame (a frame with more than [`GROUP_SIZE`] has several groups).
 #[derive(Debug, Clone)]
 struct Group {
@@ -351,6 +357,37 @@ impl CollisionModel {
 }
 
 impl Arm {
+    /// Per group of `group_pair` (both moving, with bounding spheres `spheres`: centre and
+    /// radius), the members (bit m: member m) that `near(gap, member's bound, other group's
+    /// bound)` keeps, `gap` from the other group's centre to the member's bounding-sphere centre:
+    /// a self pair with a member not kept is settled by that test. [`ALL_MEMBERS`] where the
+    /// group pair has no more pairs than members, so that the tests would cost more than they
+    /// save. Centres are placed through `centers`, as the pair loops do.
+    fn near_members(
+        &self,
+        group_pair: &GroupPair,
+        spheres: ((Vector3, Real), (Vector3, Real)),
+        (centers, frames): (&mut Centers, &[Frame; DOF + 1]),
+        near: impl Fn(Vector3, Real, Real) -> bool,
+    ) -> (u32, u32) {
+        let (a, b) = group_pair.groups;
+        let (members_a, members_b) = (&self.groups[a].members, &self.groups[b].members);
+        if group_pair.pairs.len() <= members_a.len() + members_b.len() {
+            return ALL_MEMBERS;
+        }
+        let mut mask = |members: &[usize], (center, bound): (Vector3, Real)| {
+            let mut bits = 0;
+            for (m, &i) in members.iter().enumerate() {
+                let gap = centers.get(i, &self.links, frames) - center;
+                if near(gap, self.links[i].bound, bound) {
+                    bits |= 1 << m;
+                }
+            }
+            bits
+        };
+        (mask(members_a, spheres.1), mask(members_b, spheres.0))
+    }
+
     fn new(robot: &Robot) -> Self {
         let last = robot.capsules.iter().map(|c| c.frame).max().unwrap_or(0);
         let chain = AlignedChain::new(robot, last);
@@ -695,34 +732,27 @@ impl CollisionModel {
             if group_pair.floor >= limit {
                 continue;
             }
-            // Per group, its members near the other group's bounding sphere (bit m: member m),
-            // as in `is_clear`: a member far from the other's whole group cannot lower `best`.
-            let mut near = (u32::MAX, u32::MAX);
+            // A member far from the other group's whole bounding sphere cannot lower `best`.
+            let mut near = ALL_MEMBERS;
             let (a, b) = group_pair.groups;
-            if let (Some((ca, ba)), Some((cb, bb))) = (bounding(a), bounding(b)) {
+            if let (Some(sphere_a), Some(sphere_b)) = (bounding(a), bounding(b)) {
                 let threshold = loose_pair.threshold(best);
-                if (ca - cb).norm() - ba - bb - offset >= threshold {
+                if (sphere_a.0 - sphere_b.0).norm() - sphere_a.1 - sphere_b.1 - offset >= threshold
+                {
                     continue;
                 }
-                let (members_a, members_b) =
-                    (&self.arm.groups[a].members, &self.arm.groups[b].members);
-                if group_pair.pairs.len() > members_a.len() + members_b.len() {
-                    let mut mask = |members: &[usize], center: &Vector3, bound: Real| {
-                        let mut bits = 0;
-                        for (m, &i) in members.iter().enumerate() {
-                            let gap = (centers.get(i, &self.arm.links, &frames) - center).norm();
-                            // A NaN threshold keeps the member: the pair loop decides.
-                            let far = gap - self.arm.links[i].bound - bound - offset >= threshold;
-                            if !far {
-                                bits |= 1 << m;
-                            }
-                        }
-                        bits
-                    };
-                    near = (mask(members_a, &cb, bb), mask(members_b, &ca, ba));
-                    if near.0 == 0 || near.1 == 0 {
-                        continue;
-                    }
+                near = self.arm.near_members(
+                    group_pair,
+                    (sphere_a, sphere_b),
+                    (&mut centers, &frames),
+                    |gap, member, other| {
+                        // A NaN threshold keeps the member: the pair loop decides.
+                        let far = gap.norm() - member - other - offset >= threshold;
+                        !far
+                    },
+                );
+                if near.0 == 0 || near.1 == 0 {
+                    continue;
                 }
             }
             for (k, pair) in self.arm.hot[group_pair.pairs.clone()].iter().enumerate() {
@@ -730,7 +760,7 @@ impl CollisionModel {
                 if pair.floor >= limit {
                     break;
                 }
-                if near.0 & (1 << pair.slots.0) == 0 || near.1 & (1 << pair.slots.1) == 0 {
+                if !pair.among(near) {
                     continue;
                 }
                 let levers = || &self.arm.self_pairs[group_pair.pairs.start + k].levers;
@@ -845,6 +875,14 @@ impl Placed {
 struct Centers {
     placed: u64,
     slots: [Vector3; Self::CAPACITY],
+}
+
+impl HotPair {
+    /// Whether both capsules of the pair are among the members `near` keeps
+    /// ([`Arm::near_members`]).
+    fn among(&self, near: (u32, u32)) -> bool {
+        near.0 & (1 << self.slots.0) != 0 && near.1 & (1 << self.slots.1) != 0
+    }
 }
 
 impl Centers {

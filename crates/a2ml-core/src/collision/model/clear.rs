@@ -3,11 +3,8 @@
 //! first pair too close and computes no distance it does not need, for the discrete edge checks
 //! of sampling planners.
 
-use super::{Centers, CollisionModel, GROUP_SIZE, Posed, ROUNDING};
-use crate::math::{DOF, JointVector, Real, Vector3, segment_segment_distance};
-
-// A group's members are told apart by the bits of a u32 in [`scan`].
-const _: () = assert!(GROUP_SIZE <= 32);
+use super::{ALL_MEMBERS, Centers, CollisionModel, GROUP_SIZE, Posed, ROUNDING};
+use crate::math::{DOF, JointVector, Real, segment_segment_distance};
 
 /// How much each shape of a [`CollisionModel`] is inflated in [`is_clear`] (m): per arm capsule,
 /// per self pair (the two capsules' relative motion) and per group of them, the largest of
@@ -236,33 +233,25 @@ fn scan(
         if group_pair.floor >= keep {
             continue;
         }
-        // Per group, its members near the other group's bounding sphere (bit m: member m):
-        // a pair with a member far from the other's whole group keeps the clearance.
-        let mut near = (u32::MAX, u32::MAX);
+        // A pair with a member far from the other group's whole bounding sphere keeps the
+        // clearance.
+        let mut near = ALL_MEMBERS;
         let (a, b) = group_pair.groups;
-        if let (Some((ca, ba)), Some((cb, bb))) = (group_center(a), group_center(b)) {
-            if (ca - cb).norm() - ba - bb >= keep {
+        if let (Some(sphere_a), Some(sphere_b)) = (group_center(a), group_center(b)) {
+            if (sphere_a.0 - sphere_b.0).norm() - sphere_a.1 - sphere_b.1 >= keep {
                 continue;
             }
-            // Worth it where the pairs outnumber the members tested.
-            let (members_a, members_b) = (&arm.groups[a].members, &arm.groups[b].members);
-            if group_pair.pairs.len() > members_a.len() + members_b.len() {
-                let mut mask = |members: &[usize], center: &Vector3, bound: Real| {
-                    let mut bits = 0;
-                    for (m, &i) in members.iter().enumerate() {
-                        let reach = keep + arm.links[i].bound + bound;
-                        if (centers.get(i, &arm.links, &frames) - center).norm_squared()
-                            < reach * reach
-                        {
-                            bits |= 1 << m;
-                        }
-                    }
-                    bits
-                };
-                near = (mask(members_a, &cb, bb), mask(members_b, &ca, ba));
-                if near.0 == 0 || near.1 == 0 {
-                    continue;
-                }
+            near = arm.near_members(
+                group_pair,
+                (sphere_a, sphere_b),
+                (&mut centers, &frames),
+                |gap, member, other| {
+                    let reach = keep + member + other;
+                    gap.norm_squared() < reach * reach
+                },
+            );
+            if near.0 == 0 || near.1 == 0 {
+                continue;
             }
         }
         for k in group_pair.pairs.clone() {
@@ -270,7 +259,7 @@ fn scan(
             if pair.floor >= limit + inflation.group_pairs[gp] * scale {
                 break;
             }
-            if near.0 & (1 << pair.slots.0) == 0 || near.1 & (1 << pair.slots.1) == 0 {
+            if !pair.among(near) {
                 continue;
             }
             let keep = limit + inflation.pair(pair.distal, pair.start) * scale;

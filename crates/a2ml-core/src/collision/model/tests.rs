@@ -401,6 +401,12 @@ fn a_model_with_another_scene_answers_as_a_new_one() {
     }
 }
 
+/// The independent distance (parry's, over every pair) of `robot` at `q` in `scene`: ∞ when
+/// there is no pair.
+fn independent_distance(robot: &Robot, scene: &CollisionScene, q: &JointVector) -> Real {
+    min_distance(robot, &arm_pose(robot, q), scene).map_or(Real::INFINITY, |(d, _, _)| d)
+}
+
 /// The one-pass verdict on the self pairs alone (no obstacles, where the members-near-the-
 /// other-group masks decide most pairs): uninflated, `Blocked` exactly where the independent
 /// `min_distance` is within the clearance; inflated along a motion, `Clear` only where every
@@ -418,8 +424,7 @@ fn verdicts_on_self_pairs_match_the_independent_distance() {
         for k in 0..1500 {
             let margin = if k % 2 == 0 { 0.0 } else { 0.01 };
             let q = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
-            let exact = min_distance(robot, &arm_pose(robot, &q), &scene)
-                .map_or(Real::INFINITY, |(d, _, _)| d);
+            let exact = independent_distance(robot, &scene, &q);
             let plain = verdict(&model, &q, margin, &none);
             assert_ne!(plain, Verdict::Tight, "robot {r}: nothing is inflated");
             if (exact - margin).abs() > 1e-9 {
@@ -445,8 +450,7 @@ fn verdicts_on_self_pairs_match_the_independent_distance() {
             if inflated == Verdict::Clear {
                 for t in 0..=20 {
                     let p = q + dq * (s * (t as Real / 10.0 - 1.0));
-                    let d = min_distance(robot, &arm_pose(robot, &p), &scene)
-                        .map_or(Real::INFINITY, |(d, _, _)| d);
+                    let d = independent_distance(robot, &scene, &p);
                     assert!(d >= margin - 1e-9, "robot {r}: {d} m within the covered motion");
                 }
             }
@@ -468,9 +472,7 @@ fn clearance_and_advancement_on_self_pairs_match_the_independent_distance() {
         let scene = CollisionScene::new(&[]);
         let model = CollisionModel::new(robot, &scene);
         let (lower, upper) = (robot.lower(), robot.upper());
-        let distance = |q: &JointVector| {
-            min_distance(robot, &arm_pose(robot, q), &scene).map_or(Real::INFINITY, |(d, _, _)| d)
-        };
+        let distance = |q: &JointVector| independent_distance(robot, &scene, q);
         for k in 0..1000 {
             let q = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
             let exact = distance(&q);
