@@ -411,10 +411,19 @@ fn one_distance_pass_gives_the_per_obstacle_distances_and_the_clearance() {
                         .find(|p| p.obstacle_frame.is_none() && p.link == series.capsule)
                         .map(|p| p.distance)
                 };
-                assert_eq!(
-                    series.distance[k], expected,
-                    "{name}: {} at sample {k}",
-                    series.capsule
+                // The pass's closed forms against parry's GJK, which may stop up to
+                // MEASURE_SLACK above the exact distance.
+                let slack = a2ml::collision::MEASURE_SLACK;
+                let agrees = match (series.distance[k], expected) {
+                    (Some(found), Some(parrys)) => {
+                        found <= parrys + 1e-9 && found >= parrys - slack
+                    }
+                    (found, parrys) => found == parrys,
+                };
+                assert!(
+                    agrees,
+                    "{name}: {} at sample {k}: {:?} against parry's {expected:?}",
+                    series.capsule, series.distance[k]
                 );
             }
         }

@@ -199,10 +199,23 @@ impl<T: Copy, const N: usize> IntoIterator for Few<T, N> {
 /// Distance between the segments p1–q1 and p2–q2 (Ericson, Real-Time Collision Detection
 /// §5.1.9).
 pub fn segment_segment_distance(p1: &Vector3, q1: &Vector3, p2: &Vector3, q2: &Vector3) -> Real {
+    let (s, t) = segment_segment_closest(p1, q1, p2, q2);
+    ((p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t)).norm()
+}
+
+/// The parameters (s, t) in [0, 1]² of the closest points p1 + s (q1 − p1) and
+/// p2 + t (q2 − p2) of two segments (Ericson, Real-Time Collision Detection, 5.1.9); for
+/// parallel segments one of the closest pairs.
+pub fn segment_segment_closest(
+    p1: &Vector3,
+    q1: &Vector3,
+    p2: &Vector3,
+    q2: &Vector3,
+) -> (Real, Real) {
     let (d1, d2, r) = (q1 - p1, q2 - p2, p1 - p2);
     let (a, e, f) = (d1.norm_squared(), d2.norm_squared(), d2.dot(&r));
     let tiny = Real::MIN_POSITIVE;
-    let (s, t) = if a <= tiny && e <= tiny {
+    if a <= tiny && e <= tiny {
         (0.0, 0.0)
     } else if a <= tiny {
         (0.0, (f / e).clamp(0.0, 1.0))
@@ -228,8 +241,7 @@ pub fn segment_segment_distance(p1: &Vector3, q1: &Vector3, p2: &Vector3, q2: &V
                 (s, t)
             }
         }
-    };
-    ((p1 + d1 * s) - (p2 + d2 * t)).norm()
+    }
 }
 
 #[cfg(test)]

@@ -27,8 +27,8 @@ mod model;
 
 pub use guard::{ShapeError, check_shapes};
 pub use model::{
-    CollisionModel, Inflation, Verdict, advancement, advancement_at_least, advancement_within,
-    clearance, is_clear, motion_bound, verdict,
+    Closest, CollisionModel, Inflation, Pair, Verdict, advancement, advancement_at_least,
+    advancement_within, clearance, is_clear, motion_bound, verdict,
 };
 
 /// How much [`min_distance`] or [`clearance`] may differ from the exact
@@ -70,6 +70,11 @@ impl CollisionScene {
     /// Names of the obstacles, in the order given.
     pub fn names(&self) -> impl Iterator<Item = &str> {
         self.bodies.iter().map(|b| b.name.as_str())
+    }
+
+    /// The name of obstacle `k` (in the order given).
+    pub fn name(&self, k: usize) -> &str {
+        &self.bodies[k].name
     }
 
     /// Number of obstacles.

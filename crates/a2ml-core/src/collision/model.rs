@@ -17,8 +17,10 @@ use crate::math::{
 use crate::robot::{LinkRole, Robot};
 
 mod clear;
+mod pairs;
 
 pub use clear::{Inflation, Verdict, is_clear, verdict};
+pub use pairs::{Closest, Pair};
 
 /// The arm's capsules and a scene's obstacles, prepared for [`clearance`] and
 /// [`advancement`] at many configurations.
@@ -34,6 +36,16 @@ pub struct CollisionModel {
     capsules: Vec<Capsule>,
     /// Boxes and cylinders: closed forms, parry for a segment's depth inside.
     convex: Vec<Convex>,
+    /// The scene's obstacles in its order, each where it is kept above.
+    obstacles: Vec<ObstacleSlot>,
+}
+
+/// Where one of the scene's obstacles is kept in a [`CollisionModel`].
+#[derive(Debug, Clone, Copy)]
+enum ObstacleSlot {
+    Sphere(usize),
+    Capsule(usize),
+    Convex(usize),
 }
 
 /// The arm's capsules and self pairs, prepared once per robot.
@@ -50,6 +62,10 @@ struct Arm {
     /// `self_pairs`' fields the loop over all of them reads, in the same order.
     hot: Vec<HotPair>,
     group_pairs: Vec<GroupPair>,
+    /// The capsules that move (not the base's), in the robot's order.
+    moving: Vec<usize>,
+    /// The robot's self pairs in its order ([`Robot::self_pairs`]).
+    pairs_in_order: Vec<(usize, usize)>,
 }
 
 /// At most this many capsules per [`Group`], so that a check keeps their running bounds on
@@ -172,13 +188,30 @@ impl Convex {
     /// A lower bound of the signed distance from the segment a–b to the solid, within
     /// [`SEGMENT_TOLERANCE`] of it, if below `below`; `None` when it is not. A segment that
     /// enters the solid, or one whose bracket does not close within 64 steps, is parry's;
-    /// the rest is settled in closed form.
+    /// the rest is settled in closed form ([`Convex::segment_search`]).
+    fn segment_distance(&self, a: &Vector3, b: &Vector3, below: Real) -> Option<Real> {
+        match self.segment_search(a, b, below) {
+            Search::Settled { lower, .. } => (lower < below).then_some(lower),
+            Search::Above => None,
+            // The segment enters the solid, or the bracket did not close to the tolerance (a
+            // secant that alternates ends near an edge or a rim shrinks it slowly): parry's
+            // exact distance or depth, so that the answer is never further than the tolerance
+            // below it.
+            Search::Unsettled => {
+                let posed = Posed::new(*a, *b, 0.0);
+                posed.convex_distance(&self.body, below).filter(|&d| d < below)
+            }
+        }
+    }
+
+    /// The closed form of [`Convex::segment_distance`], and where along the segment it is
+    /// reached.
     ///
     /// Along the segment the signed distance f(t) is convex, so the tangents at the ends of a
     /// bracket [lo, hi] of its minimum (f′(lo) < 0 < f′(hi)) meet below it: their crossing is a
     /// lower bound, the smaller end an upper one, and the crossing is where the bracket is
     /// split next (a secant step on f′). Most pairs end at the first crossing, above `below`.
-    fn segment_distance(&self, a: &Vector3, b: &Vector3, below: Real) -> Option<Real> {
+    fn segment_search(&self, a: &Vector3, b: &Vector3, below: Real) -> Search {
         let along = b - a;
         let at = |t: Real| {
             let (f, g) = self.point_distance_gradient(&(a + along * t));
@@ -186,15 +219,18 @@ impl Convex {
         };
         let ((mut f_lo, mut g_lo), (mut f_hi, mut g_hi)) = (at(0.0), at(1.0));
         let (mut lo, mut hi) = (0.0, 1.0);
-        let exact = |f: Real| (f < below).then_some(f);
+        let exact = |f: Real, at: Real| {
+            if f < below { Search::Settled { lower: f, at } } else { Search::Above }
+        };
         // A slope that does not descend into the segment puts the minimum at an end.
         if g_lo >= 0.0 && f_lo > 0.0 {
-            return exact(f_lo);
+            return exact(f_lo, 0.0);
         }
         if g_hi <= 0.0 && f_hi > 0.0 {
-            return exact(f_hi);
+            return exact(f_hi, 1.0);
         }
-        let mut upper = f_lo.min(f_hi);
+        // The smallest value met, and where.
+        let (mut upper, mut upper_at) = if f_lo <= f_hi { (f_lo, 0.0) } else { (f_hi, 1.0) };
         // Which end of the bracket moved last: a secant step that keeps moving the same end
         // converges slowly (as regula falsi does), so then the bracket is halved.
         let (mut moved_lo, mut halve) = (None, false);
@@ -208,10 +244,14 @@ impl Convex {
             // Only a bound at or above zero is settled this way: below it the answer is a
             // depth, and parry's penetration depth of a segment is not the deepest point's.
             if lower >= below && below >= 0.0 {
-                return None;
+                return Search::Above;
             }
             if upper - lower <= SEGMENT_TOLERANCE {
-                return (lower < below).then_some(lower);
+                return if lower < below {
+                    Search::Settled { lower, at: upper_at }
+                } else {
+                    Search::Above
+                };
             }
             if width <= Real::EPSILON {
                 break;
@@ -223,9 +263,11 @@ impl Convex {
                 crossing.clamp(lo + 0.01 * width, hi - 0.01 * width)
             };
             let (f, g) = at(t);
-            upper = upper.min(f);
+            if f < upper {
+                (upper, upper_at) = (f, t);
+            }
             if g == 0.0 && f > 0.0 {
-                return exact(f);
+                return exact(f, t);
             }
             let side = g < 0.0;
             if side {
@@ -236,12 +278,21 @@ impl Convex {
             halve = moved_lo == Some(side);
             moved_lo = Some(side);
         }
-        // The segment enters the solid, or the bracket did not close to the tolerance (a
-        // secant that alternates ends near an edge or a rim shrinks it slowly): parry's exact
-        // distance or depth, so that the answer is never further than the tolerance below it.
-        let posed = Posed::new(*a, *b, 0.0);
-        posed.convex_distance(&self.body, below).filter(|&d| d < below)
+        Search::Unsettled
     }
+}
+
+/// What [`Convex::segment_search`] found.
+#[derive(Debug, Clone, Copy)]
+enum Search {
+    /// The distance is `lower` (within [`SEGMENT_TOLERANCE`] above it), below the bound asked
+    /// for, at most [`SEGMENT_TOLERANCE`] less than the solid's distance from the segment's
+    /// point at fraction `at`.
+    Settled { lower: Real, at: Real },
+    /// Not below the bound asked for.
+    Above,
+    /// The segment enters the solid, or the bracket did not close: parry's to answer.
+    Unsettled,
 }
 
 /// A robot capsule in its moving frame.
@@ -321,7 +372,13 @@ impl CollisionModel {
 
     fn of(arm: Arc<Arm>, scene: &CollisionScene) -> Self {
         let (mut spheres, mut capsules, mut convex) = (Vec::new(), Vec::new(), Vec::new());
+        let mut obstacles = Vec::with_capacity(scene.bodies.len());
         for body in &scene.bodies {
+            obstacles.push(match body.shape {
+                Core::Ball(_) => ObstacleSlot::Sphere(spheres.len()),
+                Core::Segment(_) => ObstacleSlot::Capsule(capsules.len()),
+                Core::Cuboid(_) | Core::Cylinder(_) => ObstacleSlot::Convex(convex.len()),
+            });
             match body.shape {
                 Core::Ball(ball) => {
                     let t = body.pose.translation;
@@ -352,7 +409,7 @@ impl CollisionModel {
                 }
             }
         }
-        Self { arm, spheres, capsules, convex }
+        Self { arm, spheres, capsules, convex, obstacles }
     }
 }
 
@@ -518,7 +575,11 @@ impl Arm {
                 floor: p.floor,
             })
             .collect();
-        Self { chain, links, groups, self_pairs, hot, group_pairs }
+        let moving = (0..robot.capsules.len())
+            .filter(|&i| robot.capsules[i].role != LinkRole::Base)
+            .collect();
+        let pairs_in_order = robot.self_pairs.clone();
+        Self { chain, links, groups, self_pairs, hot, group_pairs, moving, pairs_in_order }
     }
 }
 

@@ -2,11 +2,11 @@
 //! the paper's Fig. 11 draws (upper arm, forearm and hand against the safety distance).
 //!
 //! One query per sample ([`distance_pass`]): the arm is posed once and every capsule-obstacle
-//! pair and self pair measured once, which gives both the per-capsule series and the sample's
-//! clearance (the smallest of those pairs, as [`super::min_clearance`] finds it).
+//! pair and self pair measured once in closed form ([`CollisionModel::measure_pairs`]), which
+//! gives both the per-capsule series and the sample's clearance (the smallest of those pairs,
+//! as [`super::min_clearance`] finds it).
 
-use crate::collision::{self, CollisionScene, DistanceOptions};
-use crate::kinematics::arm_pose;
+use crate::collision::{CollisionModel, CollisionScene, Pair};
 use crate::language::Obstacle;
 use crate::math::Real;
 use crate::robot::{LinkRole, Robot};
@@ -37,9 +37,6 @@ pub struct DistancePass {
     /// samples, at its first worst sample; `None` when no pair was measured.
     pub clearance: Option<Clearance>,
 }
-
-/// Far enough that every capsule-obstacle pair of a workspace is measured (m).
-const EVERY_PAIR: Real = 1e3;
 
 /// The signed distance of every moving capsule to every obstacle of `scene` (in {b}) at each
 /// sample; [`DistancePass::distances`] of [`distance_pass`].
@@ -81,44 +78,53 @@ pub fn distance_pass(
         })
         .collect();
     let collision_scene = CollisionScene::new(scene);
-    let options = DistanceOptions { influence: EVERY_PAIR };
-    let mut clearance: Option<Clearance> = None;
+    let model = CollisionModel::new(robot, &collision_scene);
+    // The model's obstacle pairs are capsule by capsule over the same moving capsules; a
+    // series is obstacle by obstacle.
+    let mut slot_of: Vec<Option<usize>> = vec![None; robot.capsules.len()];
+    for (j, &(i, _)) in moving.iter().enumerate() {
+        slot_of[i] = Some(j);
+    }
+    let mut clearance: Option<(Real, Real, Pair)> = None;
     let mut row: Vec<Option<Real>> = vec![None; distances.len()];
+    let mut touched: Vec<bool> = vec![false; scene.len()];
     for (sample, (&time, q)) in trajectory.times().iter().zip(trajectory.positions()).enumerate() {
-        let touched: Vec<bool> = scene.iter().map(|o| contact(sample, &o.name)).collect();
-        row.fill(None);
-        let pose = arm_pose(robot, q);
-        for pair in collision::distances(robot, &pose, &collision_scene, &options) {
-            if pair.obstacle_frame.is_none() {
-                let Some(k) = scene.iter().position(|o| o.name == pair.obstacle) else {
-                    continue;
-                };
-                if touched[k] {
-                    continue;
-                }
-                // Capsules that share a name are met in the robot's order: each takes the
-                // first slot of its name still empty.
-                let slots = &mut row[k * moving.len()..(k + 1) * moving.len()];
-                let free = moving
-                    .iter()
-                    .zip(slots.iter())
-                    .position(|((_, name), slot)| *name == pair.link.as_str() && slot.is_none());
-                if let Some(j) = free {
-                    slots[j] = Some(pair.distance);
-                }
-            }
-            if clearance.as_ref().is_none_or(|c| pair.distance < c.distance) {
-                clearance = Some(Clearance {
-                    distance: pair.distance,
-                    time,
-                    link: pair.link,
-                    obstacle: pair.obstacle,
-                });
-            }
+        for (k, o) in scene.iter().enumerate() {
+            touched[k] = contact(sample, &o.name);
         }
+        row.fill(None);
+        model.measure_pairs(q, |pair, distance| {
+            if let Pair::Obstacle { capsule, obstacle } = pair {
+                if touched[obstacle] {
+                    return;
+                }
+                if let Some(j) = slot_of[capsule] {
+                    row[obstacle * moving.len() + j] = Some(distance);
+                }
+            }
+            if clearance.is_none_or(|(d, _, _)| distance < d) {
+                clearance = Some((distance, time, pair));
+            }
+        });
         for (series, value) in distances.iter_mut().zip(&row) {
             series.distance.push(*value);
         }
     }
+    let clearance = clearance.map(|(distance, time, pair)| {
+        let (link, obstacle) = pair_names(robot, &collision_scene, pair);
+        Clearance { distance, time, link, obstacle }
+    });
     DistancePass { distances, clearance }
+}
+
+/// The names of a pair's two sides: the capsule's, and the obstacle's or the other capsule's.
+pub(super) fn pair_names(robot: &Robot, scene: &CollisionScene, pair: Pair) -> (String, String) {
+    let capsule = |i: usize| robot.capsules[i].name.clone();
+    match pair {
+        Pair::Obstacle { capsule: i, obstacle } => (capsule(i), scene.name(obstacle).to_owned()),
+        Pair::SelfPair(k) => {
+            let (a, b) = robot.self_pairs[k];
+            (capsule(a), capsule(b))
+        }
+    }
 }

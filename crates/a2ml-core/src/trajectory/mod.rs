@@ -10,7 +10,6 @@
 //! of that curve, not only at the samples.
 
 use crate::collision::{self, CollisionScene, MEASURE_SLACK, clearance_bound};
-use crate::kinematics::arm_pose;
 use crate::math::{DOF, JointVector, Real};
 use crate::profile::ProfileError;
 use crate::robot::Robot;
@@ -407,25 +406,30 @@ pub struct Clearance {
     pub obstacle: String,
 }
 
-/// The smallest [`collision::min_distance`] over the trajectory's samples, with when and
-/// between what it occurs (the first worst sample); `None` when there is no pair to measure.
-/// The same as [`distance_pass`]'s clearance, without the per-capsule series. parry measures
-/// only the samples that may be the worst: [`collision::clearance_bound`] leaves out those near a sample
-/// already measured, and the exact closed-form [`collision::clearance`] those whose distance,
-/// less what parry may be off by ([`collision::MEASURE_SLACK`]), is above the smallest so far.
+/// The smallest signed distance of any pair (as [`collision::min_distance`] considers them)
+/// over the trajectory's samples, with when and between what it occurs (the first worst
+/// sample); `None` when there is no pair to measure. The same as [`distance_pass`]'s
+/// clearance, without the per-capsule series. Every pair is measured
+/// ([`collision::CollisionModel::nearest_pair`]) only at the samples that may be the worst:
+/// [`collision::clearance_bound`] leaves out those near a sample already measured, and
+/// [`collision::clearance`] (the same closed forms, with a broadphase) those whose distance,
+/// less [`collision::MEASURE_SLACK`], is above the smallest so far.
 pub fn min_clearance(
     trajectory: &Trajectory,
     robot: &Robot,
     scene: &CollisionScene,
 ) -> Option<Clearance> {
-    let measure = |q: &JointVector| collision::min_distance(robot, &arm_pose(robot, q), scene);
     let (times, positions) = (&trajectory.times, &trajectory.positions);
     let model = collision::CollisionModel::new(robot, scene);
+    let measure = |q: &JointVector| {
+        let (distance, pair) = model.nearest_pair(q)?;
+        let (link, obstacle) = distances::pair_names(robot, scene, pair);
+        Some((distance, link, obstacle))
+    };
     let exact = |q: &JointVector| collision::clearance(&model, q);
     // A first look at every STRIDE-th sample (and the last) bounds the smallest distance
-    // from above, so that the pass below can leave out the samples far from it. Above zero
-    // the closed form is within MEASURE_SLACK of parry; at or below zero the bound is only
-    // compared with zero.
+    // from above, so that the pass below can leave out the samples far from it. At or below
+    // zero the bound is only compared with zero.
     const STRIDE: usize = 16;
     let last = positions.len().checked_sub(1)?;
     let mut above = Real::INFINITY;

@@ -1,4 +1,5 @@
 use super::*;
+use crate::kinematics::arm_pose;
 use crate::language::{Obstacle, Shape};
 use crate::math::Vector3;
 
@@ -185,36 +186,41 @@ fn min_clearance_is_the_worst_sample() {
         .iter()
         .map(|q| collision::min_distance(&robot, &arm_pose(&robot, q), &scene).expect("pairs").0)
         .collect();
+    // parry's distances, the independent measure: the same smallest distance (sphere and
+    // capsule distances are closed forms in both), at the same sample, between the same pair.
     let smallest = per_sample.iter().copied().fold(Real::INFINITY, Real::min);
-    assert_eq!(worst.distance, smallest);
-    let i = tr.times().iter().position(|&t| t == worst.time).expect("a sample time");
-    let (d, link, obstacle) =
+    assert!((worst.distance - smallest).abs() < 1e-12, "{} against {smallest}", worst.distance);
+    let i = per_sample.iter().position(|&d| d == smallest).expect("a sample");
+    assert_eq!(worst.time, tr.times()[i]);
+    let (_, link, obstacle) =
         collision::min_distance(&robot, &arm_pose(&robot, &tr.positions()[i]), &scene)
             .expect("pairs");
-    assert_eq!(
-        (worst.distance, worst.link.as_str(), worst.obstacle.as_str()),
-        (d, link.as_str(), obstacle.as_str())
-    );
+    assert_eq!((worst.link.as_str(), worst.obstacle.as_str()), (link.as_str(), obstacle.as_str()));
 }
 
-/// Every sample measured, as min_clearance did before it left out the samples its bound
-/// rules out: the first sample of the smallest distance.
+/// Every sample measured with the same closed forms, as min_clearance did before it left
+/// out the samples its bound rules out: the first sample of the smallest distance; and
+/// parry's smallest distance over the samples, the independent measure.
 fn exhaustive_clearance(
     tr: &Trajectory,
     robot: &Robot,
     scene: &CollisionScene,
-) -> Option<Clearance> {
+) -> (Option<Clearance>, Option<Real>) {
+    let model = collision::CollisionModel::new(robot, scene);
     let mut best: Option<Clearance> = None;
+    let mut parrys: Option<Real> = None;
     for (&time, q) in tr.times().iter().zip(tr.positions()) {
-        if let Some((distance, link, obstacle)) =
-            collision::min_distance(robot, &arm_pose(robot, q), scene)
-        {
+        if let Some((distance, pair)) = model.nearest_pair(q) {
             if best.as_ref().is_none_or(|b| distance < b.distance) {
+                let (link, obstacle) = distances::pair_names(robot, scene, pair);
                 best = Some(Clearance { distance, time, link, obstacle });
             }
         }
+        if let Some((distance, ..)) = collision::min_distance(robot, &arm_pose(robot, q), scene) {
+            parrys = Some(parrys.map_or(distance, |d: Real| d.min(distance)));
+        }
     }
-    best
+    (best, parrys)
 }
 
 /// The samples min_clearance leaves out never change its answer: the same distance, time
@@ -274,8 +280,18 @@ fn min_clearance_equals_measuring_every_sample() {
         // 2 ms samples, as the solvers give them.
         let tr = move_to(a, b, 1.0, 0.002);
         let fast = min_clearance(&tr, &robot, &scene);
-        let every = exhaustive_clearance(&tr, &robot, &scene);
+        let (every, parrys) = exhaustive_clearance(&tr, &robot, &scene);
         assert_eq!(fast, every);
+        // Never above parry's measure by more than parry may be off by, and below it by at
+        // most what a closed form may be (a penetration of a box is parry's depth in both).
+        let (found, parrys) = (every.as_ref().map(|c| c.distance), parrys);
+        if let (Some(found), Some(parrys)) = (found, parrys) {
+            assert!(
+                found <= parrys + 1e-9 && found >= parrys - MEASURE_SLACK,
+                "{found} against {parrys}"
+            );
+        }
+        assert_eq!(found.is_some(), parrys.is_some());
         skipped_any |= every.is_some_and(|c| c.distance > 0.0);
     }
     assert!(skipped_any, "no motion stayed clear: the bound was never tried");

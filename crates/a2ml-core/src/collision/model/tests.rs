@@ -496,3 +496,121 @@ fn clearance_and_advancement_on_self_pairs_match_the_independent_distance() {
         }
     }
 }
+
+/// An obstacle of every kind near the arm's reach, turned at random.
+fn mixed_scene(number: &mut impl FnMut(Real, Real) -> Real) -> Vec<crate::language::Obstacle> {
+    use crate::language::{Obstacle, Shape};
+    let near = |number: &mut dyn FnMut(Real, Real) -> Real| {
+        v(number(-0.6, 0.6), number(-0.6, 0.6), number(-0.6, 0.6))
+    };
+    let mut obstacles = Vec::new();
+    for k in 0..4 {
+        let (_, shape) = random_solid(number, k, [(0.02, 0.5); 3]);
+        let shape = match shape {
+            Shape::Box { size, rotation, .. } => {
+                Shape::Box { center: near(number), size, rotation }
+            }
+            Shape::Cylinder { radius, height, rotation, .. } => {
+                Shape::Cylinder { center: near(number), radius: 0.5 * radius, height, rotation }
+            }
+            other => other,
+        };
+        obstacles.push(Obstacle { name: format!("solid {k}"), shape });
+    }
+    let a = near(number);
+    let b = a + v(number(-0.3, 0.3), number(-0.3, 0.3), number(-0.3, 0.3));
+    let radius = number(0.01, 0.1);
+    obstacles.push(Obstacle { name: "bar".into(), shape: Shape::Capsule { a, b, radius } });
+    let (center, radius) = (near(number), number(0.01, 0.15));
+    obstacles.push(Obstacle { name: "ball".into(), shape: Shape::Sphere { center, radius } });
+    obstacles
+}
+
+/// Every pair's distance from the closed forms is parry's ([`super::super::distances`], the
+/// independent measure, which visits the pairs in the same order), to within what parry's GJK
+/// may be off by; the nearest pair is the smallest of them; and the closest points of the pairs
+/// within the influence distance are the measured pairs' own: each point on its shape's
+/// surface, apart by the distance along the normal.
+#[test]
+fn pairs_match_parrys_pairs() {
+    use crate::collision::{DistanceOptions, distances};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(47);
+    let root = format!("{}/../..", env!("CARGO_MANIFEST_DIR"));
+    let (mut measured, mut near, mut penetrating) = (0, 0, 0);
+    for name in ["robots/coman_right_arm.urdf", "robots/panda.urdf", "robots/iiwa14.urdf"] {
+        let robot = Robot::from_urdf_file(format!("{root}/{name}")).expect("robot loads");
+        let (lower, upper) = (robot.lower(), robot.upper());
+        for _ in 0..40 {
+            let obstacles = mixed_scene(&mut |lo, hi| rng.random_range(lo..hi));
+            let scene = CollisionScene::new(&obstacles);
+            let model = CollisionModel::new(&robot, &scene);
+            for _ in 0..10 {
+                let q = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+                let pose = arm_pose(&robot, &q);
+                let parrys = distances(&robot, &pose, &scene, &DistanceOptions { influence: 1e3 });
+                let mut mine = Vec::new();
+                model.measure_pairs(&q, |pair, d| mine.push((pair, d)));
+                assert_eq!(mine.len(), parrys.len());
+                for ((pair, d), p) in mine.iter().zip(&parrys) {
+                    let expected = match *pair {
+                        Pair::Obstacle { capsule, obstacle } => {
+                            (robot.capsules[capsule].name.as_str(), scene.name(obstacle))
+                        }
+                        Pair::SelfPair(k) => {
+                            let (a, b) = robot.self_pairs[k];
+                            (robot.capsules[a].name.as_str(), robot.capsules[b].name.as_str())
+                        }
+                    };
+                    assert_eq!(expected, (p.link.as_str(), p.obstacle.as_str()));
+                    let slack = crate::collision::MEASURE_SLACK;
+                    assert!(
+                        *d <= p.distance + 1e-9 && *d >= p.distance - slack,
+                        "{pair:?} at {q}: {d} against parry's {}",
+                        p.distance
+                    );
+                    penetrating += usize::from(*d < 0.0);
+                }
+                measured += mine.len();
+                let smallest = mine.iter().map(|(_, d)| *d).fold(Real::INFINITY, Real::min);
+                assert_eq!(model.nearest_pair(&q).map(|(d, _)| d), Some(smallest));
+                let influence = 0.1;
+                let mut closest = Vec::new();
+                model.near_pairs(&q, influence, &mut closest);
+                let within: Vec<_> = mine.iter().filter(|(_, d)| *d < influence).collect();
+                assert_eq!(closest.len(), within.len(), "at {q}");
+                for (c, (pair, d)) in closest.iter().zip(within) {
+                    assert_eq!(c.pair, *pair);
+                    assert!((c.distance - d).abs() <= 1e-9, "{pair:?}: {} against {d}", c.distance);
+                    assert!((c.normal.norm() - 1.0).abs() < 1e-9);
+                    let apart = c.on_link - c.on_other;
+                    assert!((apart - c.normal * c.distance).norm() < 1e-6, "{pair:?}: {c:?}");
+                    let capsule = |i: usize| {
+                        let (a, b) = (
+                            pose.frames[robot.capsules[i].frame]
+                                * nalgebra::Point3::from(robot.capsules[i].a),
+                            pose.frames[robot.capsules[i].frame]
+                                * nalgebra::Point3::from(robot.capsules[i].b),
+                        );
+                        (a.coords, b.coords, robot.capsules[i].radius)
+                    };
+                    let on_capsule = |(a, b, r): (Vector3, Vector3, Real), p: &Vector3| {
+                        (Posed::new(a, b, r).squared_distance_to_point(p).sqrt() - r).abs() < 1e-6
+                    };
+                    let link = match c.pair {
+                        Pair::Obstacle { capsule: i, .. } => i,
+                        Pair::SelfPair(k) => robot.self_pairs[k].0,
+                    };
+                    assert!(on_capsule(capsule(link), &c.on_link), "{pair:?}: {c:?}");
+                    if let Pair::SelfPair(k) = c.pair {
+                        assert!(on_capsule(capsule(robot.self_pairs[k].1), &c.on_other));
+                    }
+                    near += 1;
+                }
+            }
+        }
+    }
+    assert!(
+        measured > 10_000 && near > 500 && penetrating > 100,
+        "{measured} {near} {penetrating}"
+    );
+}
