@@ -61,7 +61,14 @@ pub struct Chart {
     /// Chart length of one metre of wrist motion: moving the wrist by half the arm's reach
     /// counts as much as turning by one radian.
     position_scale: Real,
+    /// The references' values at the σ of [`Chart::deviation`]'s scan, computed once for the
+    /// many states a motion is judged at: empty where no path component moves (nothing to
+    /// scan).
+    scan: Vec<[Target; 3]>,
 }
+
+/// Intervals of [`Chart::deviation`]'s scan over [0, σ_max].
+const SCAN: usize = 64;
 
 impl Chart {
     /// The chart of `problem`: its path components (role [`Role::Path`]) share σ, its goal
@@ -101,6 +108,12 @@ impl Chart {
             },
             _ => 1.0,
         };
+        let scan = if moving.is_empty() || sigma_max <= 0.0 {
+            Vec::new()
+        } else {
+            let h = sigma_max / SCAN as Real;
+            (0..=SCAN).map(|i| references.map(|r| r.at_fraction(i as Real * h))).collect()
+        };
         Self {
             space: problem.space,
             references,
@@ -109,6 +122,7 @@ impl Chart {
             sigma_max,
             path_scale: if path_scale > 0.0 { path_scale } else { 1.0 },
             position_scale,
+            scan,
         }
     }
 
@@ -184,10 +198,10 @@ impl Chart {
         // A path component whose reference does not move (a hold) is at the same value at
         // every σ (σ scales a zero distance), so its error is measured once, not at every σ
         // tried; goal components are 0.
-        let error_at = |k: usize, sigma: Real| -> Real {
-            let v = self.variables[k];
-            goal_error(state, &[(v, self.references[k].at_fraction(sigma))])
+        let error_of = |k: usize, target: Target| -> Real {
+            goal_error(state, &[(self.variables[k], target)])
         };
+        let error_at = |k: usize, sigma: Real| error_of(k, self.references[k].at_fraction(sigma));
         let fixed: [Option<Real>; 3] = std::array::from_fn(|k| {
             if !self.on_path[k] {
                 Some(0.0)
@@ -246,12 +260,13 @@ impl Chart {
         // A scan, then golden-section search in the best bracket: the worst error along the
         // path is unimodal near its minimum, not necessarily over the whole path. Each point
         // is evaluated once: the grid's values are kept, and each golden step reuses one.
-        const SCAN: usize = 64;
         let h = self.sigma_max / SCAN as Real;
-        let best = (0..=SCAN)
-            .map(|i| {
+        let best = (self.scan.iter().enumerate())
+            .map(|(i, targets)| {
                 let sigma = i as Real * h;
-                (sigma, worst(sigma))
+                let e =
+                    std::array::from_fn(|k| fixed[k].unwrap_or_else(|| error_of(k, targets[k])));
+                (sigma, worst_of(&e))
             })
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map_or(0.0, |(sigma, _)| sigma);
