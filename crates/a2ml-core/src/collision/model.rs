@@ -147,9 +147,20 @@ impl Convex {
     /// [`Convex::point_distance`] and a subgradient of it at `p` ({b}): the signed distance
     /// to a convex solid is convex, so `d + g·(x − p)` is below it at every `x`.
     fn point_distance_gradient(&self, p: &Vector3) -> (Real, Vector3) {
-        let local = self.rotation.tr_mul(&(p - self.body.center));
+        let (distance, gradient) = self.local_distance_gradient(&self.local(p));
+        (distance, self.rotation * gradient)
+    }
+
+    /// The point `p` ({b}) in the solid's own axes, about its centre.
+    fn local(&self, p: &Vector3) -> Vector3 {
+        self.rotation.tr_mul(&(p - self.body.center))
+    }
+
+    /// [`Convex::point_distance_gradient`] of a point in the solid's own axes
+    /// ([`Convex::local`]), the subgradient in those axes too.
+    fn local_distance_gradient(&self, local: &Vector3) -> (Real, Vector3) {
         let sign = local.map(|x| if x < 0.0 { -1.0 } else { 1.0 });
-        let (distance, gradient) = match self.solid {
+        match self.solid {
             Solid::Cuboid { half } => {
                 let d = local.abs() - half;
                 let outside = d.sup(&Vector3::zeros());
@@ -181,8 +192,7 @@ impl Convex {
                     (axial, up)
                 }
             }
-        };
-        (distance, self.rotation * gradient)
+        }
     }
 
     /// A lower bound of the signed distance from the segment a–b to the solid, within
@@ -212,9 +222,11 @@ impl Convex {
     /// lower bound, the smaller end an upper one, and the crossing is where the bracket is
     /// split next (a secant step on f′). Most pairs end at the first crossing, above `below`.
     fn segment_search(&self, a: &Vector3, b: &Vector3, below: Real) -> Search {
-        let along = b - a;
+        // In the solid's own axes: a point along the segment is then one multiply-add away,
+        // and the slope a dot product in the same axes.
+        let (a, along) = (self.local(a), self.rotation.tr_mul(&(b - a)));
         let at = |t: Real| {
-            let (f, g) = self.point_distance_gradient(&(a + along * t));
+            let (f, g) = self.local_distance_gradient(&(a + along * t));
             (f, g.dot(&along))
         };
         let ((mut f_lo, mut g_lo), (mut f_hi, mut g_hi)) = (at(0.0), at(1.0));

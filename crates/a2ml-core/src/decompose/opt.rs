@@ -328,10 +328,17 @@ impl Search<'_> {
         self.evaluations += 1;
         let end = ArmState::from_space(self.robot, self.space, &self.values(x, 1.0))?;
         let margin = self.options.limit_margin;
-        let q = ik_cpsa(self.robot, &end.cpsa, Some(&self.start_q))
-            .ok()?
-            .into_iter()
-            .find(|q| self.robot.within_limits(q, -margin))?;
+        // The in-limit branch nearest the start that keeps the margin: the nearest alone
+        // (ik_cpsa's first solution, without the others) unless it misses the margin.
+        let nearest = ik_cpsa_nearest(self.robot, &end.cpsa, &self.start_q).ok()?;
+        let q = if self.robot.within_limits(&nearest, -margin) {
+            nearest
+        } else {
+            ik_cpsa(self.robot, &end.cpsa, Some(&self.start_q))
+                .ok()?
+                .into_iter()
+                .find(|q| self.robot.within_limits(q, -margin))?
+        };
         if !self.clear(&q) {
             return None;
         }
