@@ -241,6 +241,11 @@ impl Convex {
         if g_hi <= 0.0 && f_hi > 0.0 {
             return exact(f_hi, 1.0);
         }
+        if let Solid::Cuboid { half } = self.solid {
+            if f_lo > 0.0 && f_hi > 0.0 {
+                return cuboid_search(&half, &a, &along, below);
+            }
+        }
         // The smallest value met, and where.
         let (mut upper, mut upper_at) = if f_lo <= f_hi { (f_lo, 0.0) } else { (f_hi, 1.0) };
         // Which end of the bracket moved last: a secant step that keeps moving the same end
@@ -292,6 +297,68 @@ impl Convex {
         }
         Search::Unsettled
     }
+}
+
+/// [`Convex::segment_search`] for a box of half-sides `half` and the segment from `a` along
+/// `along` (both in the box's axes), both ends outside it, in closed form. The squared
+/// distance Σ_i max(|a_i + t along_i| − half_i, 0)² is a convex quadratic between the (at most
+/// six) t where a coordinate crosses a face's plane: each piece's minimiser is exact, and the
+/// smallest of them the minimum. A segment that meets the box is parry's.
+fn cuboid_search(half: &Vector3, a: &Vector3, along: &Vector3, below: Real) -> Search {
+    let mut ts = [0.0; 8];
+    ts[1] = 1.0;
+    let mut n = 2;
+    for i in 0..3 {
+        if along[i] != 0.0 {
+            for side in [-half[i], half[i]] {
+                let t = (side - a[i]) / along[i];
+                if t > 0.0 && t < 1.0 {
+                    ts[n] = t;
+                    n += 1;
+                }
+            }
+        }
+    }
+    let ts = &mut ts[..n];
+    ts.sort_unstable_by(Real::total_cmp);
+    let outside = |t: Real| ((a + along * t).abs() - half).sup(&Vector3::zeros()).norm();
+    let (mut best, mut best_at) = (Real::INFINITY, 0.0);
+    for piece in ts.windows(2) {
+        let (t0, t1) = (piece[0], piece[1]);
+        // The faces each coordinate is beyond, the same over the piece: its middle's.
+        let middle = a + along * (0.5 * (t0 + t1));
+        let (mut num, mut den, mut beyond) = (0.0, 0.0, false);
+        for i in 0..3 {
+            // Beyond a face the excess is s (a_i + t along_i) − half_i, s its side's sign.
+            let s = if middle[i] > half[i] {
+                1.0
+            } else if middle[i] < -half[i] {
+                -1.0
+            } else {
+                continue;
+            };
+            beyond = true;
+            num += (s * a[i] - half[i]) * s * along[i];
+            den += along[i] * along[i];
+        }
+        if !beyond {
+            // Within every slab of the box: the segment meets it.
+            return Search::Unsettled;
+        }
+        // Beyond faces whose planes the segment runs along only: the same distance all over.
+        let t = if den > 0.0 { (-num / den).clamp(t0, t1) } else { t0 };
+        let f = outside(t);
+        if f < best {
+            (best, best_at) = (f, t);
+        }
+    }
+    if best <= 0.0 {
+        return Search::Unsettled;
+    }
+    // Measured at a point of the segment, so never below the minimum; the minimiser is exact
+    // but for rounding, which moves the value by far less than ROUNDING.
+    let lower = best - ROUNDING;
+    if lower < below { Search::Settled { lower, at: best_at } } else { Search::Above }
 }
 
 /// What [`Convex::segment_search`] found.

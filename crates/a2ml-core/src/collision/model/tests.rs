@@ -159,8 +159,9 @@ fn segment_distances_to_solids_match_parry() {
         let model = CollisionModel::new(&robot, &scene);
         let convex = &model.convex[0];
         let a = center + v(number(-0.7, 0.7), number(-0.7, 0.7), number(-0.7, 0.7));
-        // Every fourth segment parallel to a face or the axis, where the minimum is a plateau.
-        let b = if k % 4 == 1 {
+        // Every other segment parallel to a box's face or a cylinder's axis, where the minimum
+        // is a plateau.
+        let b = if k % 4 == 1 || k % 4 == 2 {
             a + convex.rotation.column(k % 3) * number(-0.4, 0.4)
         } else {
             a + v(number(-0.4, 0.4), number(-0.4, 0.4), number(-0.4, 0.4))
