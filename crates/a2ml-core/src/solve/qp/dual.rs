@@ -127,6 +127,16 @@ impl Constraints<'_> {
     /// By how much x violates constraint `k` (a·x − b), and the size of its terms, the scale
     /// its rounding is measured against.
     fn excess(&self, k: usize, x: &Vector7) -> (Real, Real) {
+        // A bound's normal is ±e_i: its dot product and terms are x_i's alone (the zeros add
+        // nothing), without the seven products.
+        if k < DOF {
+            let b = self.upper[k];
+            return (x[k] - b, 1.0 + x[k].abs() + b.abs());
+        }
+        if k < 2 * DOF {
+            let (i, b) = (k - DOF, -self.lower[k - DOF]);
+            return (-x[i] - b, 1.0 + x[i].abs() + b.abs());
+        }
         let (a, b) = self.get(k);
         let terms = a.iter().zip(x.iter()).map(|(a, x)| (a * x).abs()).sum::<Real>();
         (a.dot(x) - b, 1.0 + terms + b.abs())
