@@ -453,27 +453,29 @@ impl CollisionModel {
         let (mut spheres, mut capsules, mut convex) = (Vec::new(), Vec::new(), Vec::new());
         let mut obstacles = Vec::with_capacity(scene.bodies.len());
         for body in &scene.bodies {
-            obstacles.push(match body.shape {
-                Core::Ball(_) => ObstacleSlot::Sphere(spheres.len()),
-                Core::Segment(_) => ObstacleSlot::Capsule(capsules.len()),
-                Core::Cuboid(_) | Core::Cylinder(_) => ObstacleSlot::Convex(convex.len()),
-            });
-            match body.shape {
+            let slot = match body.shape {
                 Core::Ball(ball) => {
                     let t = body.pose.translation;
                     spheres
-                        .push(Sphere { center: Vector3::new(t.x, t.y, t.z), radius: ball.radius })
+                        .push(Sphere { center: Vector3::new(t.x, t.y, t.z), radius: ball.radius });
+                    ObstacleSlot::Sphere(spheres.len() - 1)
                 }
-                Core::Segment(s) => capsules.push(Capsule {
-                    a: Vector3::new(s.a.x, s.a.y, s.a.z),
-                    b: Vector3::new(s.b.x, s.b.y, s.b.z),
-                    radius: body.margin,
-                }),
-                Core::Cuboid(cuboid) => convex.push(Convex {
-                    body: body.clone(),
-                    rotation: rotation_of(&body.pose),
-                    solid: Solid::Cuboid { half: from_parry(cuboid.half_extents) },
-                }),
+                Core::Segment(s) => {
+                    capsules.push(Capsule {
+                        a: Vector3::new(s.a.x, s.a.y, s.a.z),
+                        b: Vector3::new(s.b.x, s.b.y, s.b.z),
+                        radius: body.margin,
+                    });
+                    ObstacleSlot::Capsule(capsules.len() - 1)
+                }
+                Core::Cuboid(cuboid) => {
+                    convex.push(Convex {
+                        body: body.clone(),
+                        rotation: rotation_of(&body.pose),
+                        solid: Solid::Cuboid { half: from_parry(cuboid.half_extents) },
+                    });
+                    ObstacleSlot::Convex(convex.len() - 1)
+                }
                 Core::Cylinder(cylinder) => {
                     // parry's cylinder runs along its y; the closed form wants it along z.
                     let z_to_y = Rotation3::from_axis_angle(&Vector3::x_axis(), -PI / 2.0);
@@ -484,9 +486,11 @@ impl CollisionModel {
                             radius: cylinder.radius,
                             half_height: cylinder.half_height,
                         },
-                    })
+                    });
+                    ObstacleSlot::Convex(convex.len() - 1)
                 }
-            }
+            };
+            obstacles.push(slot);
         }
         Self { arm, spheres, capsules, convex, obstacles }
     }

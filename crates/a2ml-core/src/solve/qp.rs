@@ -314,9 +314,6 @@ struct Step {
 /// once, and what it measured.
 struct Controller<'a> {
     robot: &'a Robot,
-    /// The obstacles, for the tests' reference rows from parry.
-    #[cfg(test)]
-    scene: &'a CollisionScene,
     /// The segment's problem; once the loop stops while moving, the hold of where it stopped.
     problem: SegmentProblem,
     /// The segment's own components, whose hard path holds while braking too.
@@ -351,8 +348,6 @@ impl<'a> Controller<'a> {
     ) -> Self {
         Self {
             robot,
-            #[cfg(test)]
-            scene,
             weights: WeightSchedule::new(problem.duration, options.weights),
             path: problem.components,
             problem,
@@ -597,39 +592,7 @@ impl<'a> Controller<'a> {
         let mut near = Vec::new();
         self.model.near_pairs(q, o.influence, &mut near);
         near.iter()
-            .map(|p| {
-                let relative = relative_jacobian(self.robot, pose, p);
-                let a = -(p.normal.transpose() * relative).transpose();
-                let b = o.damper_speed * (p.distance - o.safety_distance)
-                    / (o.influence - o.safety_distance);
-                (a, b)
-            })
-            .collect()
-    }
-
-    /// [`Controller::damper_rows`] from parry's closest points of every pair
-    /// ([`collision::distances`]): the independent reference of the tests.
-    #[cfg(test)]
-    fn parry_damper_rows(&self, pose: &ArmPose) -> Vec<(Vector7, Real)> {
-        let o = self.options;
-        let near = crate::collision::distances(
-            self.robot,
-            pose,
-            self.scene,
-            &crate::collision::DistanceOptions { influence: o.influence },
-        );
-        near.iter()
-            .map(|p| {
-                let link = point_jacobian(pose, p.link_frame, &p.on_link);
-                let relative = match p.obstacle_frame {
-                    Some(frame) => link - point_jacobian(pose, frame, &p.on_obstacle),
-                    None => link,
-                };
-                let a = -(p.normal.transpose() * relative).transpose();
-                let b = o.damper_speed * (p.distance - o.safety_distance)
-                    / (o.influence - o.safety_distance);
-                (a, b)
-            })
+            .map(|p| damper_row(o, &p.normal, &relative_jacobian(self.robot, pose, p), p.distance))
             .collect()
     }
 
@@ -771,6 +734,19 @@ fn normal_basis(tangent: &nalgebra::DVector<Real>) -> Vec<nalgebra::DVector<Real
 
 /// J_p of the link's closest point, minus that of the other capsule's closest point when the
 /// other is a moving link (self-collision).
+/// The damper row of a pair at `distance` along `normal` (from the other side to the link),
+/// `relative` the Jacobian of the link's closest point relative to the other's.
+fn damper_row(
+    o: &QpOptions,
+    normal: &crate::math::Vector3,
+    relative: &crate::math::Jacobian3x7,
+    distance: Real,
+) -> (Vector7, Real) {
+    let a = -(normal.transpose() * relative).transpose();
+    let b = o.damper_speed * (distance - o.safety_distance) / (o.influence - o.safety_distance);
+    (a, b)
+}
+
 fn relative_jacobian(robot: &Robot, pose: &ArmPose, p: &Closest) -> crate::math::Jacobian3x7 {
     let frame = |capsule: usize| robot.capsules[capsule].frame;
     match p.pair {
@@ -1317,6 +1293,28 @@ mod tests {
         );
     }
 
+    /// [`Controller::damper_rows`] from parry's closest points of every pair
+    /// ([`collision::distances`]): the independent reference.
+    fn parry_damper_rows(
+        robot: &Robot,
+        scene: &CollisionScene,
+        options: &QpOptions,
+        pose: &ArmPose,
+    ) -> Vec<(Vector7, Real)> {
+        let influence = collision::DistanceOptions { influence: options.influence };
+        let near = collision::distances(robot, pose, scene, &influence);
+        near.iter()
+            .map(|p| {
+                let link = point_jacobian(pose, p.link_frame, &p.on_link);
+                let relative = match p.obstacle_frame {
+                    Some(frame) => link - point_jacobian(pose, frame, &p.on_obstacle),
+                    None => link,
+                };
+                damper_row(options, &p.normal, &relative, p.distance)
+            })
+            .collect()
+    }
+
     /// The closed-form rows are parry's ([`collision::distances`]' closest points) at every
     /// configuration: the same pairs in the same order, each row within what parry's GJK may
     /// be off by, except a pair that parry and the closed form put on either side of the
@@ -1371,7 +1369,7 @@ mod tests {
             let q = q0 + JointVector::from_fn(|_, _| rng.random_range(-1.5..1.5));
             let pose = arm_pose(&robot, &q);
             let rows = controller.damper_rows(&pose, &q);
-            let parrys = controller.parry_damper_rows(&pose);
+            let parrys = parry_damper_rows(&robot, &scene, &options, &pose);
             // The influence distance's row: b = ξ, a anything.
             let edge = |(_, b): &&(Vector7, Real)| (b - options.damper_speed).abs() < 1e-3;
             let (mine, theirs): (Vec<_>, Vec<_>) = if rows.len() == parrys.len() {

@@ -9,7 +9,7 @@
 use crate::collision::{CollisionModel, CollisionScene, Pair};
 use crate::language::Obstacle;
 use crate::math::Real;
-use crate::robot::{LinkRole, Robot};
+use crate::robot::Robot;
 
 use super::{Clearance, Trajectory};
 
@@ -59,30 +59,23 @@ pub fn distance_pass(
     scene: &[Obstacle],
     contact: impl Fn(usize, &str) -> bool,
 ) -> DistancePass {
-    let moving: Vec<(usize, &str)> = robot
-        .capsules
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| c.role != LinkRole::Base)
-        .map(|(i, c)| (i, c.name.as_str()))
-        .collect();
+    let collision_scene = CollisionScene::new(scene);
+    let model = CollisionModel::new(robot, &collision_scene);
+    let moving = model.moving_capsules();
     let mut distances: Vec<CapsuleDistances> = scene
         .iter()
         .flat_map(|o| {
-            moving.iter().map(|(i, name)| CapsuleDistances {
-                capsule: (*name).to_owned(),
-                capsule_index: *i,
+            moving.iter().map(|&i| CapsuleDistances {
+                capsule: robot.capsules[i].name.clone(),
+                capsule_index: i,
                 obstacle: o.name.clone(),
                 distance: Vec::with_capacity(trajectory.len()),
             })
         })
         .collect();
-    let collision_scene = CollisionScene::new(scene);
-    let model = CollisionModel::new(robot, &collision_scene);
-    // The model's obstacle pairs are capsule by capsule over the same moving capsules; a
-    // series is obstacle by obstacle.
+    // The model's obstacle pairs are capsule by capsule; a series is obstacle by obstacle.
     let mut slot_of: Vec<Option<usize>> = vec![None; robot.capsules.len()];
-    for (j, &(i, _)) in moving.iter().enumerate() {
+    for (j, &i) in moving.iter().enumerate() {
         slot_of[i] = Some(j);
     }
     let mut clearance: Option<(Real, Real, Pair)> = None;

@@ -421,11 +421,6 @@ pub fn min_clearance(
 ) -> Option<Clearance> {
     let (times, positions) = (&trajectory.times, &trajectory.positions);
     let model = collision::CollisionModel::new(robot, scene);
-    let measure = |q: &JointVector| {
-        let (distance, pair) = model.nearest_pair(q)?;
-        let (link, obstacle) = distances::pair_names(robot, scene, pair);
-        Some((distance, link, obstacle))
-    };
     let exact = |q: &JointVector| collision::clearance(&model, q);
     // A first look at every STRIDE-th sample (and the last) bounds the smallest distance
     // from above, so that the pass below can leave out the samples far from it. At or below
@@ -436,7 +431,8 @@ pub fn min_clearance(
     for k in (0..last).step_by(STRIDE).chain([last]) {
         above = above.min(exact(&positions[k]) + MEASURE_SLACK);
     }
-    let mut best: Option<Clearance> = None;
+    // The smallest distance, when, and the pair (named once, at the end).
+    let mut best: Option<(Real, Real, collision::Pair)> = None;
     // The last sample measured (by either): a sample near it in joint space is about as far
     // away.
     let mut anchor: Option<(&JointVector, Real)> = None;
@@ -452,12 +448,15 @@ pub fn min_clearance(
         if closed - MEASURE_SLACK > above.max(0.0) {
             continue;
         }
-        let Some((distance, link, obstacle)) = measure(q) else { continue };
+        let Some((distance, pair)) = model.nearest_pair(q) else { continue };
         anchor = Some((q, distance));
         above = above.min(distance);
-        if best.as_ref().is_none_or(|b| distance < b.distance) {
-            best = Some(Clearance { distance, time, link, obstacle });
+        if best.is_none_or(|(d, ..)| distance < d) {
+            best = Some((distance, time, pair));
         }
     }
-    best
+    best.map(|(distance, time, pair)| {
+        let (link, obstacle) = distances::pair_names(robot, scene, pair);
+        Clearance { distance, time, link, obstacle }
+    })
 }

@@ -12,7 +12,7 @@ use parry3d_f64::shape::{Segment, Shape as ParryShape};
 
 use super::{CollisionModel, Convex, ObstacleSlot, Placed, Posed, Search};
 use crate::collision::{from_parry, to_parry};
-use crate::math::{JointVector, Real, Vector3, segment_segment_closest};
+use crate::math::{JointVector, Real, Vector3, segment_segment_closest, segment_segment_distance};
 
 /// One pair of a [`CollisionModel`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -45,12 +45,15 @@ pub struct Closest {
     pub normal: Vector3,
 }
 
-impl CollisionModel {
-    /// The number of the scene's obstacles.
-    pub fn obstacle_count(&self) -> usize {
-        self.obstacles.len()
-    }
+/// What a placed capsule meets in a pair of [`CollisionModel::walk_pairs`].
+enum Against<'a> {
+    /// One of the scene's obstacles.
+    Obstacle(ObstacleSlot),
+    /// The other capsule of a self pair, placed.
+    Capsule(&'a Posed),
+}
 
+impl CollisionModel {
     /// The capsules that move (every one but the base's), as indices into the robot's
     /// capsules in their order: the capsules of the obstacle pairs.
     pub fn moving_capsules(&self) -> &[usize] {
@@ -63,19 +66,13 @@ impl CollisionModel {
     /// (exact for spheres and capsules); a penetration's depth is parry's for boxes and
     /// cylinders, as in [`super::clearance`].
     pub fn measure_pairs(&self, q: &JointVector, mut f: impl FnMut(Pair, Real)) {
-        let frames = self.arm.chain.frames(q);
-        let mut placed = Placed::new();
-        let links = &self.arm.links;
-        for &capsule in &self.arm.moving {
-            let link = placed.get(capsule, links, &frames);
-            for (obstacle, &slot) in self.obstacles.iter().enumerate() {
-                f(Pair::Obstacle { capsule, obstacle }, self.obstacle_distance(&link, slot));
-            }
-        }
-        for (k, &(a, b)) in self.arm.pairs_in_order.iter().enumerate() {
-            let (link, other) = (placed.get(a, links, &frames), placed.get(b, links, &frames));
-            f(Pair::SelfPair(k), link.distance(&other));
-        }
+        self.walk_pairs(q, |pair, link, against| {
+            let distance = match against {
+                Against::Obstacle(slot) => self.obstacle_distance(link, slot),
+                Against::Capsule(other) => link.distance(other),
+            };
+            f(pair, distance);
+        });
     }
 
     /// The pair with the smallest signed distance at `q`, and that distance (the first of
@@ -94,30 +91,39 @@ impl CollisionModel {
     /// in [`CollisionModel::measure_pairs`]' order. Pairs whose bounding spheres are that far
     /// apart are left out unmeasured.
     pub fn near_pairs(&self, q: &JointVector, influence: Real, out: &mut Vec<Closest>) {
+        self.walk_pairs(q, |pair, link, against| {
+            let (center, bound) = match against {
+                Against::Obstacle(slot) => self.obstacle_bounds(slot),
+                Against::Capsule(other) => (other.center, other.bound),
+            };
+            if (link.center - center).norm() - link.bound - bound >= influence {
+                return;
+            }
+            let found = match against {
+                Against::Obstacle(slot) => self.obstacle_closest(pair, link, slot, influence),
+                Against::Capsule(other) => {
+                    capsules_closest(pair, link, &other.a, &other.b, other.radius)
+                }
+            };
+            out.extend(found.filter(|c| c.distance < influence));
+        });
+    }
+
+    /// Calls `visit(pair, link, against)` for every pair at `q`, in
+    /// [`CollisionModel::measure_pairs`]' order, each capsule placed once.
+    fn walk_pairs(&self, q: &JointVector, mut visit: impl FnMut(Pair, &Posed, Against<'_>)) {
         let frames = self.arm.chain.frames(q);
         let mut placed = Placed::new();
         let links = &self.arm.links;
         for &capsule in &self.arm.moving {
             let link = placed.get(capsule, links, &frames);
             for (obstacle, &slot) in self.obstacles.iter().enumerate() {
-                let (center, bound) = self.obstacle_bounds(slot);
-                if (link.center - center).norm() - link.bound - bound >= influence {
-                    continue;
-                }
-                if let Some(c) = self.obstacle_closest(&link, slot, influence) {
-                    out.push(Closest { pair: Pair::Obstacle { capsule, obstacle }, ..c });
-                }
+                visit(Pair::Obstacle { capsule, obstacle }, &link, Against::Obstacle(slot));
             }
         }
         for (k, &(a, b)) in self.arm.pairs_in_order.iter().enumerate() {
             let (link, other) = (placed.get(a, links, &frames), placed.get(b, links, &frames));
-            if (link.center - other.center).norm() - link.bound - other.bound >= influence {
-                continue;
-            }
-            let found = capsules_closest(&link, &other.a, &other.b, other.radius);
-            if let Some(c) = found.filter(|c| c.distance < influence) {
-                out.push(Closest { pair: Pair::SelfPair(k), ..c });
-            }
+            visit(Pair::SelfPair(k), &link, Against::Capsule(&other));
         }
     }
 
@@ -130,8 +136,9 @@ impl CollisionModel {
             }
             ObstacleSlot::Capsule(c) => {
                 let capsule = &self.capsules[c];
-                let other = Posed::new(capsule.a, capsule.b, capsule.radius);
-                link.distance(&other)
+                segment_segment_distance(&link.a, &link.b, &capsule.a, &capsule.b)
+                    - capsule.radius
+                    - link.radius
             }
             ObstacleSlot::Convex(c) => {
                 let convex = &self.convex[c];
@@ -162,44 +169,50 @@ impl CollisionModel {
         }
     }
 
-    /// The closest points of a placed capsule and one obstacle, if closer than `influence`;
-    /// the pair's field is the caller's to set.
+    /// The closest points of `pair`: a placed capsule and one obstacle (not always closer
+    /// than `influence`: the caller filters).
     fn obstacle_closest(
         &self,
+        pair: Pair,
         link: &Posed,
         slot: ObstacleSlot,
         influence: Real,
     ) -> Option<Closest> {
-        let found = match slot {
+        match slot {
             ObstacleSlot::Sphere(s) => {
                 let sphere = &self.spheres[s];
-                capsules_closest(link, &sphere.center, &sphere.center, sphere.radius)
+                capsules_closest(pair, link, &sphere.center, &sphere.center, sphere.radius)
             }
             ObstacleSlot::Capsule(c) => {
                 let capsule = &self.capsules[c];
-                capsules_closest(link, &capsule.a, &capsule.b, capsule.radius)
+                capsules_closest(pair, link, &capsule.a, &capsule.b, capsule.radius)
             }
-            ObstacleSlot::Convex(c) => convex_closest(&self.convex[c], link, influence),
-        };
-        found.filter(|c| c.distance < influence)
+            ObstacleSlot::Convex(c) => convex_closest(pair, &self.convex[c], link, influence),
+        }
     }
 }
 
-/// The closest points of the capsule `link` and the capsule a–b of radius `radius`. Two
-/// segments that meet have no normal of their own: parry's, as [`super::super::distances`]
-/// gives it.
-fn capsules_closest(link: &Posed, a: &Vector3, b: &Vector3, radius: Real) -> Option<Closest> {
+/// The closest points of `pair`: the capsule `link` and the capsule a–b of radius `radius`.
+/// Two segments that meet have no normal of their own: parry's, as
+/// [`super::super::distances`] gives it.
+fn capsules_closest(
+    pair: Pair,
+    link: &Posed,
+    a: &Vector3,
+    b: &Vector3,
+    radius: Real,
+) -> Option<Closest> {
     let (s, t) = segment_segment_closest(&link.a, &link.b, a, b);
     let (on_link_core, on_other_core) = (link.a + link.along * s, a + (b - a) * t);
     let between = on_link_core - on_other_core;
     let core = between.norm();
     if core == 0.0 {
         let segment = Segment::new(to_parry(a), to_parry(b));
-        return parry_closest(&segment, &Pose::IDENTITY, radius, link, 0.0);
+        return parry_closest(pair, &segment, &Pose::IDENTITY, radius, link, 0.0);
     }
     let normal = between / core;
     Some(Closest {
-        pair: Pair::SelfPair(0),
+        pair,
         distance: core - link.radius - radius,
         on_link: on_link_core - normal * link.radius,
         on_other: on_other_core + normal * radius,
@@ -207,10 +220,10 @@ fn capsules_closest(link: &Posed, a: &Vector3, b: &Vector3, radius: Real) -> Opt
     })
 }
 
-/// The closest points of the capsule `link` and a box or cylinder, if closer than
+/// The closest points of `pair`: the capsule `link` and a box or cylinder, if closer than
 /// `influence`: the closed form where [`Convex::segment_search`] settles it outside the solid,
 /// else parry's.
-fn convex_closest(convex: &Convex, link: &Posed, influence: Real) -> Option<Closest> {
+fn convex_closest(pair: Pair, convex: &Convex, link: &Posed, influence: Real) -> Option<Closest> {
     let below = influence + link.radius;
     let at = if link.inverse_squared_length == 0.0 {
         Some(0.0)
@@ -226,7 +239,7 @@ fn convex_closest(convex: &Convex, link: &Posed, influence: Real) -> Option<Clos
         let (core, normal) = convex.point_distance_gradient(&point);
         if core > 0.0 {
             return Some(Closest {
-                pair: Pair::SelfPair(0),
+                pair,
                 distance: core - link.radius,
                 on_link: point - normal * link.radius,
                 on_other: point - normal * core,
@@ -235,12 +248,13 @@ fn convex_closest(convex: &Convex, link: &Posed, influence: Real) -> Option<Clos
         }
     }
     let body = &convex.body;
-    parry_closest(body.shape.as_dyn(), &body.pose, 0.0, link, influence)
+    parry_closest(pair, body.shape.as_dyn(), &body.pose, 0.0, link, influence)
 }
 
-/// parry's closest points of the capsule `link` and `shape` at `pose` grown by `margin`, if
-/// closer than `influence`: what [`super::super::distances`] computes for the pair.
+/// parry's closest points of `pair`: the capsule `link` and `shape` at `pose` grown by
+/// `margin`, if closer than `influence` (what [`super::super::distances`] computes for it).
 fn parry_closest(
+    pair: Pair,
     shape: &dyn ParryShape,
     pose: &Pose,
     margin: Real,
@@ -255,7 +269,7 @@ fn parry_closest(
     let contact = query::contact(pose, shape, &Pose::IDENTITY, &segment, prediction).ok()??;
     let normal = from_parry(contact.normal1);
     Some(Closest {
-        pair: Pair::SelfPair(0),
+        pair,
         distance: contact.dist - margins,
         on_link: from_parry(contact.point2) - normal * link.radius,
         on_other: from_parry(contact.point1) + normal * margin,
