@@ -123,6 +123,7 @@ def batch_problems(
     rows = list(qs)
     frames = np.empty((len(qs), 4, 4))
     jacobians = np.empty((len(qs), 6, 7))
+    states = (np.empty((len(qs), 3)), np.empty((len(qs), 3, 3)), np.empty(len(qs)))
 
     def theirs_fk() -> None:
         for q in rows:
@@ -149,7 +150,8 @@ def batch_problems(
             theirs_jacobian,
         ),
         "fk_many + jacobian_many vs FK + J loop": (ours_both, theirs_both),
-        "cpsa_many vs FK loop": (lambda: robot.cpsa_many(qs), theirs_fk),
+        "cpsa_many (out=) vs FK loop": (lambda: robot.cpsa_many(qs, out=states), theirs_fk),
+        "cpsa_many (new arrays) vs FK loop": (lambda: robot.cpsa_many(qs), theirs_fk),
     }
 
 

@@ -6,6 +6,7 @@ exception."""
 from __future__ import annotations
 
 import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -122,6 +123,11 @@ def test_out_arrays_are_filled_and_returned() -> None:
     np.testing.assert_array_equal(frames, r.fk_many(qs))
     np.testing.assert_array_equal(jacobians, r.jacobian_many(qs))
     pw, ow, swivel = r.cpsa_many(qs)
+    outs = (np.full((5, 3), np.nan), np.full((5, 3, 3), np.nan), np.full(5, np.nan))
+    got = r.cpsa_many(qs, out=outs)
+    assert all(g is o for g, o in zip(got, outs))
+    for g, expected in zip(got, (pw, ow, swivel)):
+        np.testing.assert_array_equal(g, expected)
     solutions = np.empty((5, 7))
     assert r.ik_cpsa_many(pw, ow, swivel, qs, out=solutions) is solutions
     np.testing.assert_array_equal(solutions, r.ik_cpsa_many(pw, ow, swivel, qs))
@@ -188,6 +194,13 @@ def test_bad_shapes_and_values_raise_clear_errors() -> None:
         r.ik_cpsa_many(pw, reflected, swivel)
     with pytest.raises(ValueError, match='on_error must be "raise" or "nan"'):
         r.ik_cpsa_many(pw, ow, swivel, on_error="skip")  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match=r"out must be a tuple \(pw, ow, swivel\)"):
+        r.cpsa_many(qs, out=np.empty((4, 3)))  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"out\[1\] \(ow\) must have shape \(4, 3, 3\), got \(4, 9\)"):
+        r.cpsa_many(qs, out=(np.empty((4, 3)), np.empty((4, 9)), np.empty(4)))
+    flat = np.empty(12)  # the swivel's array the last row of pw's: written twice at once
+    with pytest.raises(ValueError, match=r"out\[2\] \(swivel\) cannot be written"):
+        r.cpsa_many(qs, out=(flat.reshape(4, 3), np.empty((4, 3, 3)), flat[8:]))
     # The output must not be an input: q_near written while it is read.
     with pytest.raises(ValueError, match="out cannot be written"):
         r.ik_cpsa_many(pw, ow, swivel, qs, out=qs)
@@ -307,3 +320,33 @@ def test_per_call_writes_beside_a_batch_in_another_thread() -> None:
     assert batches
     for batch in batches:
         np.testing.assert_array_equal(batch, expected_batch)
+
+
+def test_large_batches_at_once_and_after_the_helpers_sleep() -> None:
+    """Large batches share out their chunks with the helper threads of the process (one
+    caller at a time; the others run alone): from several threads at once, and after a pause
+    long enough for the helpers to fall asleep (a second), every row has its bits."""
+    r = robot("iiwa14")
+    qs = configurations(r, 3000, seed=13)
+    expected_frames = np.concatenate([r.fk_many(qs[k : k + 200]) for k in range(0, 3000, 200)])
+    expected_swivel = np.concatenate([r.cpsa_many(qs[k : k + 200])[2] for k in range(0, 3000, 200)])
+    failures: list[str] = []
+
+    def work(k: int) -> None:
+        frames = np.empty((3000, 4, 4))
+        for _ in range(15):
+            if not np.array_equal(r.fk_many(qs, frames), expected_frames):
+                failures.append(f"thread {k}: fk_many")
+            if not np.array_equal(r.cpsa_many(qs)[2], expected_swivel):
+                failures.append(f"thread {k}: cpsa_many")
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(3)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert failures == []
+    time.sleep(1.2)
+    np.testing.assert_array_equal(r.fk_many(qs), expected_frames)
+    time.sleep(1.2)
+    np.testing.assert_array_equal(r.cpsa_many(qs[:1000])[2], expected_swivel[:1000])

@@ -11,7 +11,8 @@
 //! their joining and limit checks), [`metrics`] (human-likeness measures) and
 //! [`output`] (MCAP, CSV, JSON, Parquet, SVG and HTML). [`math`] fixes the scalar
 //! type and aliases, [`names`] suggests names, [`spelling`] gives every enum its one
-//! spelling, [`error`] wraps each module's error.
+//! spelling, [`error`] wraps each module's error; [`team`] holds the helper threads
+//! that the wheel's batched kinematics share a large batch with.
 
 pub mod collision;
 pub mod decompose;
@@ -26,6 +27,7 @@ pub mod profile;
 pub mod robot;
 pub mod solve;
 pub mod spelling;
+pub mod team;
 pub mod trajectory;
 
 pub use error::Error;

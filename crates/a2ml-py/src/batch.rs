@@ -6,12 +6,14 @@
 //! caller passes (`out=`) or into one array made for the result, and run the rows with the
 //! GIL released, by the core's batched kernel (`kinematics::BatchedChain`: several rows side by
 //! side). A batch of at least [`PARALLEL_ROWS`] rows is shared out in chunks between the
-//! calling thread and a thread of rayon's pool (two cores at once): a row's result never
-//! depends on the other rows, so the bits are the same as on one thread; a smaller batch runs
-//! on the calling thread, where the hand-over would cost more than it saves.
+//! calling thread and the helper threads of [`a2ml_core::team`] that come while it runs (the
+//! caller never waits for one that has not started): a row's result never depends on the
+//! other rows, so the bits are the same as on one thread; a smaller batch runs on the calling
+//! thread, where the hand-over would cost more than it saves.
 
 use a2ml_core::kinematics::{self, ArmPose, BatchedChain, CpsaState, KinematicsError};
 use a2ml_core::math::{DOF, Jacobian6x7, JointVector, Matrix3, Real, Vector3};
+use a2ml_core::team::team;
 use numpy::npyffi::{NPY_ARRAY_WRITEABLE, objects::_PyArray_GET_ITEM_DATA};
 use numpy::{
     AllowTypeChange, IntoPyArray, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyReadwriteArrayDyn,
@@ -21,6 +23,8 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::marker::Ungil;
 use pyo3::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Mutex, PoisonError};
+use std::time::Duration;
 
 use crate::convert::{not_numbers, read_joints, rotation_from, shape_text};
 use crate::errors::CoreError;
@@ -33,6 +37,17 @@ const JACOBIAN: usize = kinematics::JACOBIAN_VALUES;
 /// Rows from which a batch is split over two threads: at about 0.1 µs a row, 256 rows are
 /// some 25 µs of work, well over the few microseconds a hand-over to another thread costs.
 const PARALLEL_ROWS: usize = 256;
+
+/// The cost of a row of each batched call, roughly (a 2-core x86_64 machine, one thread): what
+/// tells a long batch, worth waking a sleeping helper before it starts ([`LONG_BATCH`]).
+const FK_ROW: Duration = Duration::from_nanos(50);
+const JACOBIAN_ROW: Duration = Duration::from_nanos(70);
+const CPSA_ROW: Duration = Duration::from_nanos(70);
+const IK_ROW: Duration = Duration::from_nanos(1_500);
+
+/// A batch of at least this much work wakes a sleeping helper before it starts: the wake-up
+/// costs the caller some 20 µs and the helper comes some 40 µs later (`a2ml_core::team`).
+const LONG_BATCH: Duration = Duration::from_micros(300);
 
 /// Output rows a batch writes, which [`in_chunks`] cuts at a row.
 trait Split: Sized {
@@ -84,19 +99,19 @@ impl Split for CpsaSlots<'_> {
 }
 
 /// Rows a thread takes at a time from a split batch: a multiple of the kernel's lanes, some
-/// 4–8 µs of work, so the calling thread does not wait long for a thread of the pool that
-/// wakes late (tens of microseconds, measured: with two fixed halves a 1,000-row batch ran
-/// only 1.1–1.2× faster than on one thread).
+/// 3–8 µs of work, so that a helper that comes late still finds some, and the calling thread
+/// waits at most about that long for the helpers inside when it finds none left.
 const CHUNK_ROWS: usize = 64;
 
 /// `run(first_row, rows of q, rows of out)` over all of `q` and `out`; each call's answer, in
 /// row order. Below [`PARALLEL_ROWS`] rows, one call on the calling thread; from there, the
-/// batch is cut into chunks of [`CHUNK_ROWS`] rows that the calling thread and one thread of
-/// rayon's pool take in turn until none is left (which thread runs a chunk changes nothing:
+/// batch is cut into chunks of [`CHUNK_ROWS`] rows that the calling thread and the helpers of
+/// [`a2ml_core::team`] take in turn until none is left (which thread runs a chunk changes nothing:
 /// a row's result never depends on the other rows).
 fn in_chunks<R: Send, O: Split + Send>(
     q: &[Real],
     q_per_row: usize,
+    row_cost: Duration,
     out: O,
     run: impl Fn(usize, &[Real], O) -> R + Sync,
 ) -> Vec<R> {
@@ -112,27 +127,34 @@ fn in_chunks<R: Send, O: Split + Send>(
         chunks.push((first, q_chunk, out_chunk));
         (q, out) = (q_rest, out_rest);
     }
-    let queue = std::sync::Mutex::new(chunks.into_iter());
-    // Chunks until the queue is empty, with their first rows.
+    // Each chunk and its answer in a slot of its own, a chunk claimed by the counter: no two
+    // threads ever want the same lock, so none waits on one.
+    let chunks: Vec<_> = chunks.into_iter().map(|chunk| Mutex::new(Some(chunk))).collect();
+    let answers: Vec<Mutex<Option<R>>> = chunks.iter().map(|_| Mutex::new(None)).collect();
+    let next = AtomicUsize::new(0);
+    // Every thread of the team runs this until no chunk is left. A poisoned lock means a
+    // thread panicked while it held it: that panic is the one `Team::run` reports.
     let drain = || {
-        let mut done = Vec::new();
         loop {
-            // A poisoned lock means the other thread panicked: its panic is the one reported.
-            let next = queue.lock().map(|mut chunks| chunks.next()).ok().flatten();
-            let Some((first, q, out)) = next else { return done };
-            done.push((first, run(first, q, out)));
+            let index = next.fetch_add(1, Ordering::Relaxed);
+            let (Some(chunk), Some(answer)) = (chunks.get(index), answers.get(index)) else {
+                return;
+            };
+            let Some((first, q, out)) = chunk.lock().ok().and_then(|mut chunk| chunk.take()) else {
+                return;
+            };
+            let result = run(first, q, out);
+            if let Ok(mut answer) = answer.lock() {
+                *answer = Some(result);
+            }
         }
     };
-    // The calling thread works from the start (rayon::join from outside the pool would hand
-    // both sides over and wait); a thread of the pool joins when it wakes.
-    let mut helped = Vec::new();
-    let mut done = rayon::in_place_scope(|scope| {
-        scope.spawn(|_| helped = drain());
-        drain()
-    });
-    done.append(&mut helped);
-    done.sort_unstable_by_key(|(first, _)| *first);
-    done.into_iter().map(|(_, r)| r).collect()
+    let long = row_cost.saturating_mul(u32::try_from(rows).unwrap_or(u32::MAX)) >= LONG_BATCH;
+    team().run(&drain, long);
+    answers
+        .into_iter()
+        .filter_map(|answer| answer.into_inner().unwrap_or_else(PoisonError::into_inner))
+        .collect()
 }
 
 /// A float64 n-dimensional numpy array.
@@ -386,13 +408,15 @@ impl OnError {
 impl PyRobot {
     /// `kernel` over the rows of `q` (N, 7), each writing one row of shape `row` into `out`
     /// (or a new (N, *row) array), with the GIL released: the input is read in place and the
-    /// kernel writes straight into the output array.
+    /// kernel writes straight into the output array. `row_cost`: a row's time, roughly.
+    #[allow(clippy::too_many_arguments)]
     fn each_row<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         out: Option<&Bound<'py, PyAny>>,
         row: &[usize],
+        row_cost: Duration,
         kernel: impl Fn(&BatchedChain, &[Real], &mut [Real]) + Sync,
     ) -> PyResult<Array<'py>> {
         let rows = read_rows(q, "q", &[DOF])?;
@@ -402,7 +426,7 @@ impl PyRobot {
         let (values, slots) = (rows.values(), slots(&mut guard));
         let per_row = row.iter().product();
         detached(py, || {
-            in_chunks(values, DOF, Slots { values: slots, per_row }, |_, q, out| {
+            in_chunks(values, DOF, row_cost, Slots { values: slots, per_row }, |_, q, out| {
                 kernel(&self.chain, q, out.values)
             })
         });
@@ -441,7 +465,7 @@ impl PyRobot {
         q: &Bound<'py, PyAny>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Array<'py>> {
-        self.each_row(py, q, out, &[4, 4], BatchedChain::hand_frames)
+        self.each_row(py, q, out, &[4, 4], FK_ROW, BatchedChain::hand_frames)
     }
 
     /// J_ge at each row of `q` (N, 7), as (N, 6, 7).
@@ -452,24 +476,45 @@ impl PyRobot {
         q: &Bound<'py, PyAny>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Array<'py>> {
-        self.each_row(py, q, out, &[6, DOF], BatchedChain::jacobians)
+        self.each_row(py, q, out, &[6, DOF], JACOBIAN_ROW, BatchedChain::jacobians)
     }
 
-    /// The CPSA state at each row of `q` (N, 7): pw (N, 3), ow (N, 3, 3), swivel (N,).
+    /// The CPSA state at each row of `q` (N, 7): pw (N, 3), ow (N, 3, 3), swivel (N,), written
+    /// into `out = (pw, ow, swivel)` when given.
+    #[pyo3(signature = (q, out=None))]
     fn cpsa_many<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<(Array<'py>, Array<'py>, Array<'py>)> {
         let rows = read_rows(q, "q", &[DOF])?;
         let n = rows.count;
+        let outs = out
+            .map(|out| {
+                out.extract::<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)>().map_err(
+                    |_| {
+                        PyTypeError::new_err(
+                            "out must be a tuple (pw, ow, swivel) of three float64 arrays",
+                        )
+                    },
+                )
+            })
+            .transpose()?;
+        let (pw_out, ow_out, swivel_out) = match &outs {
+            Some((pw, ow, swivel)) => (Some(pw), Some(ow), Some(swivel)),
+            None => (None, None, None),
+        };
         let (pw, ow, swivel) = (
-            PyArrayDyn::zeros(py, &[n, 3][..], false),
-            PyArrayDyn::zeros(py, &[n, 3, 3][..], false),
-            PyArrayDyn::zeros(py, &[n][..], false),
+            output(py, pw_out, "out[0] (pw)", &[n, 3])?,
+            output(py, ow_out, "out[1] (ow)", &[n, 3, 3])?,
+            output(py, swivel_out, "out[2] (swivel)", &[n])?,
         );
-        let (mut pw_guard, mut ow_guard, mut swivel_guard) =
-            (writer(&pw, "pw")?, writer(&ow, "ow")?, writer(&swivel, "swivel")?);
+        let (mut pw_guard, mut ow_guard, mut swivel_guard) = (
+            writer(&pw, "out[0] (pw)")?,
+            writer(&ow, "out[1] (ow)")?,
+            writer(&swivel, "out[2] (swivel)")?,
+        );
         let values = rows.values();
         let outputs = CpsaSlots {
             pw: slots(&mut pw_guard),
@@ -478,7 +523,7 @@ impl PyRobot {
         };
         // Each row written straight into the three arrays; the first failing row is reported.
         let chunks = detached(py, || {
-            in_chunks(values, DOF, outputs, |first, q, out| {
+            in_chunks(values, DOF, CPSA_ROW, outputs, |first, q, out| {
                 let failed = self.chain.cpsa_values(&self.robot, q, out.pw, out.ow, out.swivel);
                 failed.map(|(row, e)| (first + row, e))
             })
@@ -551,7 +596,7 @@ impl PyRobot {
         let near_values = near_rows.as_ref().map(|r| r.values());
         // The first failing row of each chunk, in row order.
         let chunks = detached(py, || {
-            in_chunks(pw, 3, Slots { values: out, per_row: DOF }, |first, _, out| {
+            in_chunks(pw, 3, IK_ROW, Slots { values: out, per_row: DOF }, |first, _, out| {
                 for (q, i) in out.values.chunks_exact_mut(DOF).zip(first..) {
                     let target = CpsaState {
                         pw: Vector3::from_column_slice(&pw[3 * i..3 * i + 3]),

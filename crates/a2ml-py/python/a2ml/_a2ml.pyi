@@ -259,13 +259,20 @@ class Robot:
         """:meth:`jacobian` at every row of ``q`` (N, 7): shape (N, 6, 7);
         as :meth:`fk_many`."""
 
-    def cpsa_many(self, q: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    def cpsa_many(
+        self,
+        q: ArrayLike,
+        out: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]] | None = None,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """:meth:`cpsa` at every row of ``q`` (N, 7): ``(pw (N, 3), ow (N, 3, 3),
-        swivel (N,))``; as :meth:`fk_many`.
+        swivel (N,))``; as :meth:`fk_many`. ``out``, a tuple of three float64
+        arrays of those shapes, if given, is filled and returned.
 
         Raises:
             SingularityError: at a singular row, named in the message.
-            TypeError, ValueError: as :meth:`fk_many`.
+            TypeError: as :meth:`fk_many`, or ``out`` is not a tuple of three
+                arrays.
+            ValueError: as :meth:`fk_many`, for each array of ``out``.
         """
 
     def ik_cpsa_many(
