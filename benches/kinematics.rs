@@ -36,6 +36,16 @@ fn kinematics(c: &mut Criterion) {
                 (pose.hand_frame(), geometric_jacobian(&pose))
             })
         });
+        // The same two results by the batched steps on one lane (the wheel's per-call path).
+        let chain = BatchedChain::new(&robot);
+        let row: [f64; 7] = std::array::from_fn(|k| q[k]);
+        group.bench_function("fk_hand+J_ge_one_lane", |b| {
+            let (mut frame, mut jacobian) = ([0.0; FRAME_VALUES], [0.0; JACOBIAN_VALUES]);
+            b.iter(|| {
+                chain.hand_frame_and_jacobian(black_box(&row), &mut frame, &mut jacobian);
+                black_box((&frame, &jacobian));
+            })
+        });
         group.bench_function("cpsa_state+J_cs", |b| {
             b.iter(|| {
                 let pose = arm_pose(&robot, black_box(&q));

@@ -11,8 +11,8 @@
 //! other rows, so the bits are the same as on one thread; a smaller batch runs on the calling
 //! thread, where the hand-over would cost more than it saves.
 
-use a2ml_core::kinematics::{self, ArmPose, BatchedChain, CpsaState, KinematicsError};
-use a2ml_core::math::{DOF, Jacobian6x7, JointVector, Matrix3, Real, Vector3};
+use a2ml_core::kinematics::{self, BatchedChain, CpsaState, KinematicsError};
+use a2ml_core::math::{DOF, JointVector, Matrix3, Real, Vector3};
 use a2ml_core::team::team;
 use numpy::npyffi::{NPY_ARRAY_WRITEABLE, objects::_PyArray_GET_ITEM_DATA};
 use numpy::{
@@ -312,27 +312,6 @@ fn slots<'a>(writer: &'a mut PyReadwriteArrayDyn<'_, Real>) -> &'a mut [Real] {
     writer.as_slice_mut().unwrap_or(&mut [])
 }
 
-/// The hand frame {W} as a row-major 4x4 homogeneous matrix.
-fn write_frame(out: &mut [Real], pose: &ArmPose) {
-    let r = pose.hand.matrix();
-    for i in 0..3 {
-        for j in 0..3 {
-            out[4 * i + j] = r[(i, j)];
-        }
-        out[4 * i + 3] = pose.wrist[i];
-    }
-    out[12..16].copy_from_slice(&[0.0, 0.0, 0.0, 1.0]);
-}
-
-/// J_ge row-major (nalgebra stores it by columns).
-fn write_jacobian(out: &mut [Real], j: &Jacobian6x7) {
-    for i in 0..6 {
-        for k in 0..DOF {
-            out[DOF * i + k] = j[(i, k)];
-        }
-    }
-}
-
 /// `values` (row-major, of `shape`) written into the caller's `out`, or as a new array: made
 /// from the values directly, which costs less than a zeroed array borrowed for writing.
 fn emit<'py>(
@@ -354,26 +333,37 @@ fn emit<'py>(
     Ok(array)
 }
 
-/// The hand frame {W} of `pose` (4x4), written into `out` when given.
-pub(crate) fn frame_into<'py>(
-    py: Python<'py>,
-    pose: &ArmPose,
-    out: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Array<'py>> {
-    let mut values = [0.0; FRAME];
-    write_frame(&mut values, pose);
-    emit(py, out, "out", &[4, 4], &values)
-}
+impl PyRobot {
+    /// `q` as one row of joint values (7, finite).
+    fn row(q: &Bound<'_, PyAny>) -> PyResult<[Real; DOF]> {
+        let q = read_joints(q, "q")?;
+        Ok(std::array::from_fn(|k| q[k]))
+    }
 
-/// J_ge (6x7), written into `out` when given.
-pub(crate) fn jacobian_into<'py>(
-    py: Python<'py>,
-    j: &Jacobian6x7,
-    out: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Array<'py>> {
-    let mut values = [0.0; JACOBIAN];
-    write_jacobian(&mut values, j);
-    emit(py, out, "out", &[6, DOF], &values)
+    /// The hand frame {W} at `q` (4x4), written into `out` when given: the batched kernel's
+    /// steps on one lane (`BatchedChain::hand_frame`), so a row of `fk_many` to the bit.
+    pub(crate) fn frame_into<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Array<'py>> {
+        let mut frame = [0.0; FRAME];
+        self.chain.hand_frame(&Self::row(q)?, &mut frame);
+        emit(py, out, "out", &[4, 4], &frame)
+    }
+
+    /// J_ge at `q` (6x7), written into `out` when given; as [`Self::frame_into`].
+    pub(crate) fn jacobian_into<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Array<'py>> {
+        let (mut frame, mut jacobian) = ([0.0; FRAME], [0.0; JACOBIAN]);
+        self.chain.hand_frame_and_jacobian(&Self::row(q)?, &mut frame, &mut jacobian);
+        emit(py, out, "out", &[6, DOF], &jacobian)
+    }
 }
 
 /// A core error of row `row`, as the exception the per-call method raises, its message led
@@ -447,10 +437,8 @@ impl PyRobot {
         frame_out: Option<&Bound<'py, PyAny>>,
         jacobian_out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<(Array<'py>, Array<'py>)> {
-        let pose = kinematics::arm_pose(&self.robot, &read_joints(q, "q")?);
         let (mut frame, mut jacobian) = ([0.0; FRAME], [0.0; JACOBIAN]);
-        write_frame(&mut frame, &pose);
-        write_jacobian(&mut jacobian, &kinematics::geometric_jacobian(&pose));
+        self.chain.hand_frame_and_jacobian(&Self::row(q)?, &mut frame, &mut jacobian);
         Ok((
             emit(py, frame_out, "frame_out", &[4, 4], &frame)?,
             emit(py, jacobian_out, "jacobian_out", &[6, DOF], &jacobian)?,

@@ -184,7 +184,7 @@ impl PyRobot {
         q: &Bound<'py, PyAny>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<batch::Array<'py>> {
-        batch::frame_into(py, &self.pose(q)?, out)
+        self.frame_into(py, q, out)
     }
 
     /// Shoulder, elbow and wrist centres in {b}.
@@ -205,7 +205,7 @@ impl PyRobot {
         q: &Bound<'py, PyAny>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<batch::Array<'py>> {
-        batch::jacobian_into(py, &kinematics::geometric_jacobian(&self.pose(q)?), out)
+        self.jacobian_into(py, q, out)
     }
 
     /// The CPSA state (pw, ow, swivel).

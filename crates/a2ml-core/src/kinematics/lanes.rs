@@ -1,5 +1,5 @@
 //! Forward kinematics of many configurations at once: [`BatchedChain`] runs [`LANES`]
-//! configurations side by side, each matrix entry a `[Real; LANES]`, so every step is a loop
+//! configurations side by side, each matrix entry a `[Real; N]`, so every step is a loop
 //! over lanes that the compiler vectorises (no intrinsics; the one `unsafe` is the call of
 //! the copy compiled for AVX2 once the processor is known to have it).
 //!
@@ -31,11 +31,11 @@ pub const FRAME_VALUES: usize = 16;
 pub const JACOBIAN_VALUES: usize = 6 * DOF;
 
 /// One value per lane.
-type Lane = [Real; LANES];
+type Lane<const N: usize> = [Real; N];
 /// A 3-vector per lane.
-type LaneVector = [Lane; 3];
+type LaneVector<const N: usize> = [Lane<N>; 3];
 /// A 3x3 matrix per lane, `m[row][column]`.
-type LaneMatrix = [[Lane; 3]; 3];
+type LaneMatrix<const N: usize> = [[Lane<N>; 3]; 3];
 
 /// One joint of the aligned chain: the constant transform from the parent's aligned frame to
 /// this joint's, before the turn about z.
@@ -87,7 +87,7 @@ impl Constant {
 
     /// `m c`.
     #[inline(always)]
-    fn times(&self, m: &LaneMatrix) -> LaneMatrix {
+    fn times<const N: usize>(&self, m: &LaneMatrix<N>) -> LaneMatrix<N> {
         match self {
             Self::Permutation { source, sign } => std::array::from_fn(|i| {
                 std::array::from_fn(|j| m[i][source[j]].map(|v| v * sign[j]))
@@ -150,17 +150,17 @@ pub struct BatchedChain {
 }
 
 /// What forward kinematics gives for one group of lanes, in {b}.
-struct GroupPose {
+struct GroupPose<const N: usize> {
     /// The joint axes.
-    axes: [LaneVector; DOF],
+    axes: [LaneVector<N>; DOF],
     /// The linear rows of J_ge: W's velocity per unit rate of each joint.
-    linear: [LaneVector; DOF],
-    elbow: LaneVector,
-    wrist: LaneVector,
+    linear: [LaneVector<N>; DOF],
+    elbow: LaneVector<N>,
+    wrist: LaneVector<N>,
     /// Ow.
-    hand: LaneMatrix,
+    hand: LaneMatrix<N>,
     /// θsw where asked for and regular (see [`swivels`]).
-    swivel: [Option<Real>; LANES],
+    swivel: [Option<Real>; N],
 }
 
 /// A rotation whose z column is `axis`, its x and y from a cross product with the basis
@@ -252,6 +252,27 @@ impl BatchedChain {
         });
     }
 
+    /// The hand frame {W} (row-major 4x4) at one configuration, by the batched steps on a
+    /// single lane: for a caller with one configuration at a time, to whom a group would
+    /// compute seven other rows for nothing. The bits of that row in any batch.
+    pub fn hand_frame(&self, q: &[Real; DOF], frame: &mut [Real; FRAME_VALUES]) {
+        let pose = self.group_pose::<1, false, false>(&q.map(|v| [v]));
+        write_frame(frame, &pose, 0);
+    }
+
+    /// The hand frame and J_ge at one configuration, as [`Self::hand_frame`]: the bits of that
+    /// row of [`Self::hand_frames_and_jacobians`].
+    pub fn hand_frame_and_jacobian(
+        &self,
+        q: &[Real; DOF],
+        frame: &mut [Real; FRAME_VALUES],
+        jacobian: &mut [Real; JACOBIAN_VALUES],
+    ) {
+        let pose = self.group_pose::<1, true, false>(&q.map(|v| [v]));
+        write_frame(frame, &pose, 0);
+        write_jacobian(jacobian, &pose, 0);
+    }
+
     /// The CPSA state at each row of `q`, as [`super::cpsa_state`] gives it; `states` is
     /// called with each row's index and result, in order.
     pub fn cpsa_states(
@@ -262,7 +283,7 @@ impl BatchedChain {
     ) {
         let rows = q.len() / DOF;
         self.each_group::<false, true, _>(q, 0..rows, |pose, lane, row| {
-            let point = |v: &LaneVector| Vector3::new(v[0][lane], v[1][lane], v[2][lane]);
+            let point = |v: &LaneVector<LANES>| Vector3::new(v[0][lane], v[1][lane], v[2][lane]);
             let hand = Matrix3::from_fn(|i, j| pose.hand[i][j][lane]);
             let hand = Rotation3::from_matrix_unchecked(hand);
             let state = match pose.swivel[lane] {
@@ -304,7 +325,7 @@ impl BatchedChain {
                 return;
             }
             // Near a singularity: cpsa_from_points decides, by its own tolerances.
-            let point = |v: &LaneVector| Vector3::new(v[0][lane], v[1][lane], v[2][lane]);
+            let point = |v: &LaneVector<LANES>| Vector3::new(v[0][lane], v[1][lane], v[2][lane]);
             let hand = Rotation3::from_matrix_unchecked(Matrix3::from_fn(|i, j| hand[i][j][lane]));
             match cpsa_from_points(robot, &point(&pose.elbow), &point(&pose.wrist), hand) {
                 Ok(state) => {
@@ -335,7 +356,7 @@ impl BatchedChain {
         &self,
         q: &[Real],
         outputs: impl IntoIterator<Item = O>,
-        each: impl FnMut(&GroupPose, usize, O),
+        each: impl FnMut(&GroupPose<LANES>, usize, O),
     ) {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
@@ -355,7 +376,7 @@ impl BatchedChain {
         &self,
         q: &[Real],
         outputs: impl IntoIterator<Item = O>,
-        each: impl FnMut(&GroupPose, usize, O),
+        each: impl FnMut(&GroupPose<LANES>, usize, O),
     ) {
         self.each_group_portable::<LINEAR, SWIVEL, O>(q, outputs, each);
     }
@@ -366,7 +387,7 @@ impl BatchedChain {
         &self,
         q: &[Real],
         outputs: impl IntoIterator<Item = O>,
-        mut each: impl FnMut(&GroupPose, usize, O),
+        mut each: impl FnMut(&GroupPose<LANES>, usize, O),
     ) {
         let mut outputs = outputs.into_iter();
         for group in q.chunks(DOF * LANES) {
@@ -380,7 +401,7 @@ impl BatchedChain {
                     joints[k][l] = group[DOF * lane + k];
                 }
             }
-            let pose = self.group_pose::<LINEAR, SWIVEL>(&joints);
+            let pose = self.group_pose::<LANES, LINEAR, SWIVEL>(&joints);
             for lane in 0..rows {
                 let Some(out) = outputs.next() else { return };
                 each(&pose, lane, out);
@@ -391,18 +412,18 @@ impl BatchedChain {
     /// Forward kinematics of one group: `joints[k]` holds joint k's value in each lane; J_ge's
     /// linear rows only when `LINEAR` (the frames and CPSA states do not read them).
     #[inline(always)]
-    fn group_pose<const LINEAR: bool, const SWIVEL: bool>(
+    fn group_pose<const N: usize, const LINEAR: bool, const SWIVEL: bool>(
         &self,
-        joints: &[Lane; DOF],
-    ) -> GroupPose {
-        let mut rotation: LaneMatrix = [[[0.0; LANES]; 3]; 3];
+        joints: &[Lane<N>; DOF],
+    ) -> GroupPose<N> {
+        let mut rotation: LaneMatrix<N> = [[[0.0; N]; 3]; 3];
         for (i, row) in rotation.iter_mut().enumerate() {
-            row[i] = [1.0; LANES];
+            row[i] = [1.0; N];
         }
-        let mut translation: LaneVector = [[0.0; LANES]; 3];
-        let mut axes = [[[0.0; LANES]; 3]; DOF];
-        let mut axis_points = [[[0.0; LANES]; 3]; DOF];
-        let (mut elbow, mut wrist) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3]);
+        let mut translation: LaneVector<N> = [[0.0; N]; 3];
+        let mut axes = [[[0.0; N]; 3]; DOF];
+        let mut axis_points = [[[0.0; N]; 3]; DOF];
+        let (mut elbow, mut wrist) = ([[0.0; N]; 3], [[0.0; N]; 3]);
         for (k, step) in self.steps.iter().enumerate() {
             translation = apply(&rotation, &step.translation, &translation);
             let (sin, cos) = sin_cos(&joints[k]);
@@ -425,17 +446,17 @@ impl BatchedChain {
         }
         // W's velocity per unit rate of each joint: z_k × (W - p_k); joint 7 cannot move W,
         // which rides on frame 6.
-        let mut linear = [[[0.0; LANES]; 3]; DOF];
+        let mut linear = [[[0.0; N]; 3]; DOF];
         for k in (0..DOF - 1).filter(|_| LINEAR) {
             let (z, p) = (&axes[k], &axis_points[k]);
-            for l in 0..LANES {
+            for l in 0..N {
                 let d = [wrist[0][l] - p[0][l], wrist[1][l] - p[1][l], wrist[2][l] - p[2][l]];
                 linear[k][0][l] = z[1][l] * d[2] - z[2][l] * d[1];
                 linear[k][1][l] = z[2][l] * d[0] - z[0][l] * d[2];
                 linear[k][2][l] = z[0][l] * d[1] - z[1][l] * d[0];
             }
         }
-        let swivel = if SWIVEL { swivels(&elbow, &wrist, &self.vertical) } else { [None; LANES] };
+        let swivel = if SWIVEL { swivels(&elbow, &wrist, &self.vertical) } else { [None; N] };
         GroupPose { axes, linear, elbow, wrist, hand: self.hand.times(&rotation), swivel }
     }
 }
@@ -469,10 +490,14 @@ fn dot(a: &[Real; 3], b: &[Real; 3]) -> Real {
 /// One square root a lane instead of six roots and fifteen divisions; the same angle to a few
 /// ulps, not the same bits.
 #[inline(always)]
-fn swivels(elbow: &LaneVector, wrist: &LaneVector, vertical: &Vector3) -> [Option<Real>; LANES] {
+fn swivels<const N: usize>(
+    elbow: &LaneVector<N>,
+    wrist: &LaneVector<N>,
+    vertical: &Vector3,
+) -> [Option<Real>; N] {
     let vertical = values_of(vertical);
-    let (mut a, mut b, mut regular) = ([0.0; LANES], [0.0; LANES], [false; LANES]);
-    for l in 0..LANES {
+    let (mut a, mut b, mut regular) = ([0.0; N], [0.0; N], [false; N]);
+    for l in 0..N {
         let e = [elbow[0][l], elbow[1][l], elbow[2][l]];
         let w = [wrist[0][l], wrist[1][l], wrist[2][l]];
         let ew = [w[0] - e[0], w[1] - e[1], w[2] - e[2]];
@@ -495,7 +520,7 @@ fn swivels(elbow: &LaneVector, wrist: &LaneVector, vertical: &Vector3) -> [Optio
 /// both zero, or not finite, is left to the platform's atan2.
 #[allow(clippy::excessive_precision)] // fdlibm's digits as published: the same doubles.
 #[inline(always)]
-fn atan2(y: &Lane, x: &Lane) -> Lane {
+fn atan2<const N: usize>(y: &Lane<N>, x: &Lane<N>) -> Lane<N> {
     const ATAN_HIGH: [Real; 4] = [
         4.636_476_090_008_060_935_15e-1,
         std::f64::consts::FRAC_PI_4,
@@ -522,9 +547,9 @@ fn atan2(y: &Lane, x: &Lane) -> Lane {
         1.628_582_011_536_578_236_23e-2,
     ];
     const PI_LOW: Real = 1.224_646_799_147_353_177_2e-16;
-    let mut out = [0.0; LANES];
+    let mut out = [0.0; N];
     let mut special = false;
-    for l in 0..LANES {
+    for l in 0..N {
         let (a, b) = (y[l].abs(), x[l].abs());
         // t = a / b, reduced as fdlibm's atan does: t, (2t - 1)/(2 + t), (t - 1)/(t + 1),
         // (t - 1.5)/(1 + 1.5t) or -1/t by its range, each written over a and b. Every
@@ -557,7 +582,7 @@ fn atan2(y: &Lane, x: &Lane) -> Lane {
     }
     // Both zero, or not finite: the platform's, lane by lane (rare).
     if special {
-        for l in 0..LANES {
+        for l in 0..N {
             let (a, b) = (y[l].abs(), x[l].abs());
             if !((a > 0.0 || b > 0.0) && a.is_finite() && b.is_finite()) {
                 out[l] = y[l].atan2(x[l]);
@@ -569,11 +594,11 @@ fn atan2(y: &Lane, x: &Lane) -> Lane {
 
 /// `m` turned about its z column by the angle of (sin, cos) in each lane: `m Rz(θ)`.
 #[inline(always)]
-fn turned(m: &LaneMatrix, sin: &Lane, cos: &Lane) -> LaneMatrix {
+fn turned<const N: usize>(m: &LaneMatrix<N>, sin: &Lane<N>, cos: &Lane<N>) -> LaneMatrix<N> {
     let mut out = *m;
     for i in 0..3 {
         let (x, y) = (&m[i][0], &m[i][1]);
-        for l in 0..LANES {
+        for l in 0..N {
             out[i][0][l] = x[l] * cos[l] + y[l] * sin[l];
             out[i][1][l] = y[l] * cos[l] - x[l] * sin[l];
         }
@@ -586,40 +611,40 @@ fn turned(m: &LaneMatrix, sin: &Lane, cos: &Lane) -> LaneMatrix {
 /// of onto 36 entries. A product by ±1 is exact and rounding is symmetric in sign, so
 /// `(±x) cos = x (±cos)` to the bit: the same values as `turned(&c.times(m), ..)`.
 #[inline(always)]
-fn turned_permutation(
-    m: &LaneMatrix,
+fn turned_permutation<const N: usize>(
+    m: &LaneMatrix<N>,
     source: &[usize; 3],
     sign: &[Real; 3],
-    sin: &Lane,
-    cos: &Lane,
-) -> LaneMatrix {
+    sin: &Lane<N>,
+    cos: &Lane<N>,
+) -> LaneMatrix<N> {
     // One copy per permutation, its columns known at compile time, so that the rotation can
     // stay in registers instead of being indexed in memory.
     match *source {
-        [0, 1, 2] => turned_columns::<0, 1, 2>(m, sign, sin, cos),
-        [0, 2, 1] => turned_columns::<0, 2, 1>(m, sign, sin, cos),
-        [1, 0, 2] => turned_columns::<1, 0, 2>(m, sign, sin, cos),
-        [1, 2, 0] => turned_columns::<1, 2, 0>(m, sign, sin, cos),
-        [2, 0, 1] => turned_columns::<2, 0, 1>(m, sign, sin, cos),
-        _ => turned_columns::<2, 1, 0>(m, sign, sin, cos),
+        [0, 1, 2] => turned_columns::<N, 0, 1, 2>(m, sign, sin, cos),
+        [0, 2, 1] => turned_columns::<N, 0, 2, 1>(m, sign, sin, cos),
+        [1, 0, 2] => turned_columns::<N, 1, 0, 2>(m, sign, sin, cos),
+        [1, 2, 0] => turned_columns::<N, 1, 2, 0>(m, sign, sin, cos),
+        [2, 0, 1] => turned_columns::<N, 2, 0, 1>(m, sign, sin, cos),
+        _ => turned_columns::<N, 2, 1, 0>(m, sign, sin, cos),
     }
 }
 
 /// [`turned_permutation`] for the permutation (X, Y, Z).
 #[inline(always)]
-fn turned_columns<const X: usize, const Y: usize, const Z: usize>(
-    m: &LaneMatrix,
+fn turned_columns<const N: usize, const X: usize, const Y: usize, const Z: usize>(
+    m: &LaneMatrix<N>,
     sign: &[Real; 3],
-    sin: &Lane,
-    cos: &Lane,
-) -> LaneMatrix {
-    let signed = |v: &Lane, s: Real| v.map(|x| x * s);
+    sin: &Lane<N>,
+    cos: &Lane<N>,
+) -> LaneMatrix<N> {
+    let signed = |v: &Lane<N>, s: Real| v.map(|x| x * s);
     let (cos_x, sin_x) = (signed(cos, sign[0]), signed(sin, sign[0]));
     let (cos_y, sin_y) = (signed(cos, sign[1]), signed(sin, sign[1]));
-    let mut out = [[[0.0; LANES]; 3]; 3];
+    let mut out = [[[0.0; N]; 3]; 3];
     for i in 0..3 {
         let (x, y, z) = (&m[i][X], &m[i][Y], &m[i][Z]);
-        for l in 0..LANES {
+        for l in 0..N {
             out[i][0][l] = x[l] * cos_x[l] + y[l] * sin_y[l];
             out[i][1][l] = y[l] * cos_y[l] - x[l] * sin_x[l];
             out[i][2][l] = z[l] * sign[2];
@@ -630,11 +655,11 @@ fn turned_columns<const X: usize, const Y: usize, const Z: usize>(
 
 /// `m c` with c the same in every lane.
 #[inline(always)]
-fn times_constant(m: &LaneMatrix, c: &[[Real; 3]; 3]) -> LaneMatrix {
-    let mut out = [[[0.0; LANES]; 3]; 3];
+fn times_constant<const N: usize>(m: &LaneMatrix<N>, c: &[[Real; 3]; 3]) -> LaneMatrix<N> {
+    let mut out = [[[0.0; N]; 3]; 3];
     for i in 0..3 {
         for j in 0..3 {
-            for l in 0..LANES {
+            for l in 0..N {
                 out[i][j][l] = m[i][0][l] * c[0][j] + m[i][1][l] * c[1][j] + m[i][2][l] * c[2][j];
             }
         }
@@ -646,28 +671,28 @@ fn times_constant(m: &LaneMatrix, c: &[[Real; 3]; 3]) -> LaneMatrix {
 /// skipped term is ±0, which changes no sum but the sign of a zero. The terms are summed in
 /// index order, then added to t.
 #[inline(always)]
-fn apply(m: &LaneMatrix, v: &Offset, t: &LaneVector) -> LaneVector {
+fn apply<const N: usize>(m: &LaneMatrix<N>, v: &Offset, t: &LaneVector<N>) -> LaneVector<N> {
     let mut out = *t;
     // The match outside the loops, so that each arm is a straight run of lane products.
     match *v {
         Offset::Zero => {}
         Offset::One(r, a) => {
             for i in 0..3 {
-                for l in 0..LANES {
+                for l in 0..N {
                     out[i][l] += m[i][r][l] * a;
                 }
             }
         }
         Offset::Two([(r, a), (s, b)]) => {
             for i in 0..3 {
-                for l in 0..LANES {
+                for l in 0..N {
                     out[i][l] += m[i][r][l] * a + m[i][s][l] * b;
                 }
             }
         }
         Offset::Three([a, b, c]) => {
             for i in 0..3 {
-                for l in 0..LANES {
+                for l in 0..N {
                     out[i][l] += m[i][0][l] * a + m[i][1][l] * b + m[i][2][l] * c;
                 }
             }
@@ -678,7 +703,7 @@ fn apply(m: &LaneMatrix, v: &Offset, t: &LaneVector) -> LaneVector {
 
 /// Lane `lane`'s hand frame {W} as a row-major 4x4 homogeneous matrix.
 #[inline(always)]
-fn write_frame(out: &mut [Real], pose: &GroupPose, lane: usize) {
+fn write_frame<const N: usize>(out: &mut [Real], pose: &GroupPose<N>, lane: usize) {
     let out = &mut out[..FRAME_VALUES];
     for i in 0..3 {
         for j in 0..3 {
@@ -691,7 +716,7 @@ fn write_frame(out: &mut [Real], pose: &GroupPose, lane: usize) {
 
 /// Lane `lane`'s J_ge, row-major: W's velocity (rows 0-2), the hand's angular velocity (3-5).
 #[inline(always)]
-fn write_jacobian(out: &mut [Real], pose: &GroupPose, lane: usize) {
+fn write_jacobian<const N: usize>(out: &mut [Real], pose: &GroupPose<N>, lane: usize) {
     let out = &mut out[..JACOBIAN_VALUES];
     for i in 0..3 {
         for k in 0..DOF {
@@ -714,7 +739,7 @@ const FRAC_PI_2_LOW: Real = 6.077_100_506_506_192_249_32e-11;
 
 /// Sine and cosine of each lane.
 #[inline(always)]
-fn sin_cos(x: &Lane) -> (Lane, Lane) {
+fn sin_cos<const N: usize>(x: &Lane<N>) -> (Lane<N>, Lane<N>) {
     if x.iter().all(|v| v.abs() <= REDUCTION_LIMIT) {
         reduced_sin_cos(x)
     } else {
@@ -726,14 +751,14 @@ fn sin_cos(x: &Lane) -> (Lane, Lane) {
 /// Sine and cosine for |x| ≤ [`REDUCTION_LIMIT`]: x = jπ/2 + y with |y| ≤ π/4, fdlibm's
 /// kernels at y, then the quadrant j mod 4 swaps and signs them.
 #[inline(always)]
-fn reduced_sin_cos(x: &Lane) -> (Lane, Lane) {
-    let mut shifted = [0.0; LANES];
-    for l in 0..LANES {
+fn reduced_sin_cos<const N: usize>(x: &Lane<N>) -> (Lane<N>, Lane<N>) {
+    let mut shifted = [0.0; N];
+    for l in 0..N {
         shifted[l] = x[l] * FRAC_2_PI + ROUNDER;
     }
-    let mut sin = [0.0; LANES];
-    let mut cos = [0.0; LANES];
-    for l in 0..LANES {
+    let mut sin = [0.0; N];
+    let mut cos = [0.0; N];
+    for l in 0..N {
         let j = shifted[l] - ROUNDER;
         let y = (x[l] - j * FRAC_PI_2_HIGH) - j * FRAC_PI_2_LOW;
         let (s, c) = (kernel_sin(y), kernel_cos(y));
@@ -839,7 +864,7 @@ mod tests {
         }
         assert!(worst <= 3.4e-16, "worst difference {worst:e}");
         // Past the reduction's range the platform's own, exactly.
-        let far: Lane = std::array::from_fn(|l| [3.0e5, -1.0e9, 0.5, 1e300][l % 4]);
+        let far: Lane<LANES> = std::array::from_fn(|l| [3.0e5, -1.0e9, 0.5, 1e300][l % 4]);
         let (s, c) = sin_cos(&far);
         for l in 0..LANES {
             assert_eq!((s[l], c[l]), far[l].sin_cos());
@@ -914,6 +939,31 @@ mod tests {
     /// On a processor with AVX2 the public calls run the copy compiled for it: the same bits
     /// as the portable copy (on one without, both calls run the portable copy).
     #[test]
+    fn one_configuration_gets_the_bits_of_its_row_in_a_batch() {
+        for name in ROBOTS {
+            let robot = robot(name);
+            let chain = BatchedChain::new(&robot);
+            let count = 2 * LANES + 3;
+            let q = configurations(&robot, count);
+            let (mut frames, mut jacobians) =
+                (vec![0.0; count * FRAME_VALUES], vec![0.0; count * JACOBIAN_VALUES]);
+            chain.hand_frames_and_jacobians(&q, &mut frames, &mut jacobians);
+            for (row, q) in q.chunks_exact(DOF).enumerate() {
+                let q: [Real; DOF] = std::array::from_fn(|k| q[k]);
+                let (mut frame, mut jacobian) = ([0.0; FRAME_VALUES], [0.0; JACOBIAN_VALUES]);
+                chain.hand_frame_and_jacobian(&q, &mut frame, &mut jacobian);
+                let batch_frame = &frames[row * FRAME_VALUES..(row + 1) * FRAME_VALUES];
+                let batch_jacobian = &jacobians[row * JACOBIAN_VALUES..(row + 1) * JACOBIAN_VALUES];
+                assert_eq!(bits(&frame), bits(batch_frame), "{name} row {row}");
+                assert_eq!(bits(&jacobian), bits(batch_jacobian), "{name} row {row}");
+                let mut alone = [Real::NAN; FRAME_VALUES];
+                chain.hand_frame(&q, &mut alone);
+                assert_eq!(bits(&alone), bits(&frame), "{name} row {row}");
+            }
+        }
+    }
+
+    #[test]
     fn the_avx2_copy_gives_the_portable_bits() {
         for name in ROBOTS {
             let robot = robot(name);
@@ -974,7 +1024,7 @@ mod tests {
             state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
             (state >> 11) as Real / (1u64 << 53) as Real - 0.5
         };
-        let m: LaneMatrix =
+        let m: LaneMatrix<LANES> =
             std::array::from_fn(|_| std::array::from_fn(|_| [(); LANES].map(|_| value())));
         let angles = [(); LANES].map(|_| 8.0 * value());
         let (sin, cos) = sin_cos(&angles);
@@ -984,7 +1034,7 @@ mod tests {
             let c = Constant::Permutation { source, sign };
             let expected = turned(&c.times(&m), &sin, &cos);
             let got = turned_permutation(&m, &source, &sign, &sin, &cos);
-            let bits = |m: &LaneMatrix| {
+            let bits = |m: &LaneMatrix<LANES>| {
                 m.as_flattened().as_flattened().iter().map(|v| v.to_bits()).collect::<Vec<_>>()
             };
             assert_eq!(bits(&got), bits(&expected), "{source:?} {sign:?}");
