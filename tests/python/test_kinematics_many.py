@@ -5,6 +5,9 @@ exception."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import threading
 import time
 from pathlib import Path
@@ -350,3 +353,63 @@ def test_large_batches_at_once_and_after_the_helpers_sleep() -> None:
     np.testing.assert_array_equal(r.fk_many(qs), expected_frames)
     time.sleep(1.2)
     np.testing.assert_array_equal(r.cpsa_many(qs[:1000])[2], expected_swivel[:1000])
+
+
+def _batch_threads_after_a_large_batch(setting: str | None) -> int:
+    """The threads a fresh interpreter's first large batch starts (its helpers)."""
+    env = {k: v for k, v in os.environ.items() if k != "A2ML_BATCH_THREADS"}
+    if setting is not None:
+        env["A2ML_BATCH_THREADS"] = setting
+    script = (
+        "import os, numpy as np, a2ml\n"
+        f"r = a2ml.Robot.from_urdf({str(ROBOTS_DIR / 'iiwa14.urdf')!r})\n"
+        "q = np.tile(np.linspace(-0.5, 0.5, 7), (2000, 1))\n"
+        "before = len(os.listdir('/proc/self/task'))\n"
+        "assert np.array_equal(r.fk_many(q)[1999], r.fk(q[0]))\n"
+        "print(len(os.listdir('/proc/self/task')) - before)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
+    return int(done.stdout.strip())
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads the threads off /proc")
+def test_a2ml_batch_threads_sets_the_helpers() -> None:
+    cores = len(os.sched_getaffinity(0))
+    assert _batch_threads_after_a_large_batch("1") == 0
+    assert _batch_threads_after_a_large_batch("2") == 1
+    assert _batch_threads_after_a_large_batch(None) == min(cores, 8) - 1
+    assert _batch_threads_after_a_large_batch("lots") == min(cores, 8) - 1
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="needs os.fork")
+def test_a_forked_child_computes_its_batches() -> None:
+    """A child forked beside a running batch has none of its parent's helper threads (and one
+    may have been inside that batch): its own batches still complete, with the same bits."""
+    r = robot("panda")
+    qs = configurations(r, 4000, seed=17)
+    expected = r.jacobian_many(qs)
+    stop = threading.Event()
+
+    def busy() -> None:
+        while not stop.is_set():
+            r.jacobian_many(qs)
+
+    worker = threading.Thread(target=busy)
+    worker.start()
+    try:
+        for _ in range(5):
+            read, write = os.pipe()
+            pid = os.fork()
+            if pid == 0:  # the child: one large batch, its verdict through the pipe, then out
+                os.close(read)
+                same = np.array_equal(r.jacobian_many(qs), expected)
+                os.write(write, b"1" if same else b"0")
+                os._exit(0)
+            os.close(write)
+            with os.fdopen(read, "rb") as pipe:
+                verdict = pipe.read()
+            os.waitpid(pid, 0)
+            assert verdict == b"1"
+    finally:
+        stop.set()
+        worker.join()

@@ -17,7 +17,7 @@
 use std::any::Any;
 use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering::SeqCst};
-use std::sync::{Arc, Mutex, OnceLock, PoisonError};
+use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::{self, Thread};
 use std::time::{Duration, Instant};
 
@@ -74,15 +74,45 @@ pub struct Team {
     helpers: Vec<Helper>,
 }
 
-/// The process's team, its threads started at the first large batch: one fewer than the cores
-/// the process may use, at most [`MOST_HELPERS`]. A helper that cannot be started is left out.
+/// The environment variable that sets how many threads a batch may use, its caller included:
+/// `1` runs every batch on its caller alone (no helper thread is started); unset, empty or not
+/// a positive number, the cores the process may use, at most `MOST_HELPERS + 1`. For many
+/// processes on one machine (a Dask or Ray worker per core), `1` keeps the helpers from
+/// spinning on cores the other processes need.
+pub const THREADS_VARIABLE: &str = "A2ML_BATCH_THREADS";
+
+/// The helpers a team takes, from [`THREADS_VARIABLE`]'s value and the number of cores.
+fn helpers_for(setting: Option<&str>, cores: usize) -> usize {
+    let threads = setting
+        .and_then(|text| text.trim().parse::<usize>().ok())
+        .filter(|&threads| threads > 0)
+        .unwrap_or(cores);
+    threads.saturating_sub(1).min(MOST_HELPERS)
+}
+
+/// The process's team, its threads started at the first large batch, as many as
+/// [`THREADS_VARIABLE`] says. A helper that cannot be started is left out.
+///
+/// A process forked from one with a team has none of its threads (a fork copies only the
+/// forking thread), and a helper that was inside a batch at the fork would seem inside for
+/// ever: the child, told apart by its process id, makes a team of its own (the parent's is
+/// left as it was, a few bytes).
 pub fn team() -> &'static Team {
-    static TEAM: OnceLock<Team> = OnceLock::new();
-    TEAM.get_or_init(|| {
-        let cores = thread::available_parallelism().map_or(1, usize::from);
-        let patience = Patience { linger: LINGER, doze: DOZE, idle: IDLE };
-        Team::new(cores.saturating_sub(1).min(MOST_HELPERS), patience)
-    })
+    static TEAM: Mutex<Option<(u32, &'static Team)>> = Mutex::new(None);
+    let pid = std::process::id();
+    let mut current = TEAM.lock().unwrap_or_else(PoisonError::into_inner);
+    match *current {
+        Some((owner, team)) if owner == pid => team,
+        _ => {
+            let cores = thread::available_parallelism().map_or(1, usize::from);
+            let setting = std::env::var(THREADS_VARIABLE).ok();
+            let patience = Patience { linger: LINGER, doze: DOZE, idle: IDLE };
+            let team: &'static Team =
+                Box::leak(Box::new(Team::new(helpers_for(setting.as_deref(), cores), patience)));
+            *current = Some((pid, team));
+            team
+        }
+    }
 }
 
 impl Team {
@@ -264,6 +294,23 @@ mod tests {
         doze: Duration::from_micros(100),
         idle: Duration::from_millis(3),
     };
+
+    #[test]
+    fn the_variable_sets_the_threads_of_a_batch() {
+        assert_eq!(helpers_for(None, 2), 1);
+        assert_eq!(helpers_for(None, 1), 0);
+        assert_eq!(helpers_for(None, 64), MOST_HELPERS);
+        assert_eq!(helpers_for(Some("1"), 8), 0);
+        assert_eq!(helpers_for(Some(" 3 "), 8), 2);
+        assert_eq!(helpers_for(Some("0"), 4), 3);
+        assert_eq!(helpers_for(Some("many"), 4), 3);
+        assert_eq!(helpers_for(Some(""), 2), 1);
+    }
+
+    #[test]
+    fn the_process_keeps_one_team() {
+        assert!(std::ptr::eq(team(), team()));
+    }
 
     #[test]
     fn every_piece_is_done_once_with_or_without_helpers() {

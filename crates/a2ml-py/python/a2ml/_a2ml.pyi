@@ -246,7 +246,12 @@ class Robot:
 
         A C-contiguous float64 ``q`` is read in place; the rows run with the
         GIL released, so threads may share a batch. ``out`` (N, 4, 4), if
-        given, is filled and returned.
+        given, is filled and returned. A batch of 256 rows or more shares its
+        rows with helper threads (one fewer than the cores, at most seven),
+        which watch for the next batch for a few milliseconds after one; the
+        environment variable ``A2ML_BATCH_THREADS`` (read at the first large
+        batch) sets the threads a batch may use, its caller included: ``1``
+        for none, as a process among one per core wants.
 
         Raises:
             TypeError: ``q`` is not numeric, or ``out`` not a float64 array.
