@@ -7,8 +7,9 @@
 //! thread alone would. Here the calling thread never waits for a helper that has not started:
 //! it posts its work, does it itself, and when nothing is left waits only for the helpers
 //! already inside, each at most one piece from its end. A helper keeps watching for the next
-//! batch for [`LINGER`] after its last one before it sleeps, as OpenMP runtimes and BLAS
-//! pools do between parallel regions, so a loop of batched calls finds it awake.
+//! batch for [`LINGER`] after its last one, as OpenMP runtimes and BLAS pools do between
+//! parallel regions, so a loop of batched calls finds it awake; then it dozes, then sleeps
+//! (see [`watch`]).
 //!
 //! The work is one closure that every thread runs at once; it shares itself out (each thread
 //! takes the next piece from a common queue) and returns when no piece is left. Which thread
@@ -21,7 +22,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::{self, Thread};
 use std::time::{Duration, Instant};
 
-/// How long a helper watches for the next batch after its last one before it sleeps: longer
+/// How long a helper spins for the next batch after its last one before it dozes: longer
 /// than the Python work between two batched calls of a typical loop (a millisecond or two),
 /// short enough that an idle process gives its cores back at once to a person's eye.
 pub const LINGER: Duration = Duration::from_millis(5);
@@ -165,11 +166,10 @@ impl Team {
         let own = catch_unwind(AssertUnwindSafe(work));
         // From here no helper enters; the ones inside are at most a piece from the end.
         shared.posted.store(0, SeqCst);
-        for spins in 0_u32.. {
-            if shared.inside.load(SeqCst) == 0 {
-                break;
-            }
+        let mut spins: u32 = 0;
+        while shared.inside.load(SeqCst) != 0 {
             pause(spins);
+            spins = spins.wrapping_add(1);
         }
         let helpers = shared.panic.lock().unwrap_or_else(PoisonError::into_inner).take();
         shared.posting.store(false, SeqCst);
@@ -183,9 +183,7 @@ impl Team {
             resume_unwind(panic);
         }
     }
-}
 
-impl Team {
     /// Unparks the helpers that sleep.
     fn wake(&self) {
         for helper in &self.helpers {
@@ -202,7 +200,10 @@ impl Team {
 fn watch(shared: &Shared, asleep: &AtomicBool, patience: Patience) {
     let mut done = 0;
     let mut idle_since = Instant::now();
-    for spins in 0_u32.. {
+    // Wrapping: a helper lives as long as its process, and only the counter's low bits matter.
+    let mut spins: u32 = 0;
+    loop {
+        spins = spins.wrapping_add(1);
         let generation = shared.generation.load(SeqCst);
         if generation != done {
             // A post since the last look. `posted` is stored before the count moves, so 0
@@ -231,10 +232,14 @@ fn watch(shared: &Shared, asleep: &AtomicBool, patience: Patience) {
         }
         pause(spins);
         // The clock read every 256 spins (some microseconds): cheap against the spin itself.
-        if spins % 256 != 255 || idle_since.elapsed() < patience.linger {
+        if spins % 256 != 255 {
             continue;
         }
-        if idle_since.elapsed() < patience.idle {
+        let idle = idle_since.elapsed();
+        if idle < patience.linger {
+            continue;
+        }
+        if idle < patience.idle {
             thread::park_timeout(patience.doze);
             continue;
         }

@@ -399,7 +399,6 @@ impl PyRobot {
     /// `kernel` over the rows of `q` (N, 7), each writing one row of shape `row` into `out`
     /// (or a new (N, *row) array), with the GIL released: the input is read in place and the
     /// kernel writes straight into the output array. `row_cost`: a row's time, roughly.
-    #[allow(clippy::too_many_arguments)]
     fn each_row<'py>(
         &self,
         py: Python<'py>,

@@ -888,9 +888,7 @@ mod tests {
             let chain = BatchedChain::new(&robot);
             let count = 4 * LANES + 3;
             let q = configurations(&robot, count);
-            let mut frames = vec![Real::NAN; count * FRAME_VALUES];
-            let mut jacobians = vec![Real::NAN; count * JACOBIAN_VALUES];
-            chain.hand_frames_and_jacobians(&q, &mut frames, &mut jacobians);
+            let (frames, jacobians) = frames_and_jacobians(&chain, &q);
             for (i, row) in q.chunks_exact(DOF).enumerate() {
                 let pose = arm_pose(&robot, &joint_vector(row));
                 let h = pose.hand_frame().to_homogeneous();
@@ -914,9 +912,7 @@ mod tests {
         let chain = BatchedChain::new(&robot);
         let count = 3 * LANES + 1;
         let q = configurations(&robot, count);
-        let (mut frames, mut jacobians) =
-            (vec![0.0; count * FRAME_VALUES], vec![0.0; count * JACOBIAN_VALUES]);
-        chain.hand_frames_and_jacobians(&q, &mut frames, &mut jacobians);
+        let (frames, jacobians) = frames_and_jacobians(&chain, &q);
         let (mut alone_frames, mut alone_jacobians) = (frames.clone(), jacobians.clone());
         alone_frames.fill(0.0);
         alone_jacobians.fill(0.0);
@@ -936,8 +932,6 @@ mod tests {
         assert_eq!(bits(&pieces), bits(&frames));
     }
 
-    /// On a processor with AVX2 the public calls run the copy compiled for it: the same bits
-    /// as the portable copy (on one without, both calls run the portable copy).
     #[test]
     fn one_configuration_gets_the_bits_of_its_row_in_a_batch() {
         for name in ROBOTS {
@@ -945,9 +939,7 @@ mod tests {
             let chain = BatchedChain::new(&robot);
             let count = 2 * LANES + 3;
             let q = configurations(&robot, count);
-            let (mut frames, mut jacobians) =
-                (vec![0.0; count * FRAME_VALUES], vec![0.0; count * JACOBIAN_VALUES]);
-            chain.hand_frames_and_jacobians(&q, &mut frames, &mut jacobians);
+            let (frames, jacobians) = frames_and_jacobians(&chain, &q);
             for (row, q) in q.chunks_exact(DOF).enumerate() {
                 let q: [Real; DOF] = std::array::from_fn(|k| q[k]);
                 let (mut frame, mut jacobian) = ([0.0; FRAME_VALUES], [0.0; JACOBIAN_VALUES]);
@@ -963,6 +955,8 @@ mod tests {
         }
     }
 
+    /// On a processor with AVX2 the public calls run the copy compiled for it: the same bits
+    /// as the portable copy (on one without, both calls run the portable copy).
     #[test]
     fn the_avx2_copy_gives_the_portable_bits() {
         for name in ROBOTS {
@@ -970,9 +964,7 @@ mod tests {
             let chain = BatchedChain::new(&robot);
             let count = 3 * LANES + 2;
             let q = configurations(&robot, count);
-            let (mut frames, mut jacobians) =
-                (vec![0.0; count * FRAME_VALUES], vec![0.0; count * JACOBIAN_VALUES]);
-            chain.hand_frames_and_jacobians(&q, &mut frames, &mut jacobians);
+            let (frames, jacobians) = frames_and_jacobians(&chain, &q);
             let (mut portable_frames, mut portable_jacobians) =
                 (vec![0.0; count * FRAME_VALUES], vec![0.0; count * JACOBIAN_VALUES]);
             let rows = portable_frames
@@ -1050,19 +1042,23 @@ mod tests {
             let (fast, slow) = (BatchedChain::new(&robot), BatchedChain::general(&robot));
             let count = 3 * LANES + 1;
             let q = configurations(&robot, count);
-            let run = |chain: &BatchedChain| {
-                let (mut frames, mut jacobians) =
-                    (vec![0.0; count * FRAME_VALUES], vec![0.0; count * JACOBIAN_VALUES]);
-                chain.hand_frames_and_jacobians(&q, &mut frames, &mut jacobians);
-                (frames, jacobians)
-            };
-            let (fast, slow) = (run(&fast), run(&slow));
+            let (fast, slow) = (frames_and_jacobians(&fast, &q), frames_and_jacobians(&slow, &q));
             let d = largest_difference(&fast.0, &slow.0).max(largest_difference(&fast.1, &slow.1));
             assert!(d <= 1e-14, "{name}: {d:e}");
             if name == "iiwa14" {
                 assert!(fast == slow, "{name}: the exact constants change a value");
             }
         }
+    }
+
+    /// The hand frames and J_ge of every row of `q` by the public call, into arrays of NaN (a
+    /// row left unwritten stays NaN).
+    fn frames_and_jacobians(chain: &BatchedChain, q: &[Real]) -> (Vec<Real>, Vec<Real>) {
+        let count = q.len() / DOF;
+        let mut frames = vec![Real::NAN; count * FRAME_VALUES];
+        let mut jacobians = vec![Real::NAN; count * JACOBIAN_VALUES];
+        chain.hand_frames_and_jacobians(q, &mut frames, &mut jacobians);
+        (frames, jacobians)
     }
 
     fn bits(values: &[Real]) -> Vec<u64> {
