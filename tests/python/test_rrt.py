@@ -54,3 +54,34 @@ def test_bad_obstacles_and_blocked_ends_raise() -> None:
     ball = [{"type": "sphere", "position": [0, 0, 0.5], "radius": 2.0}]
     with pytest.raises(a2ml.PlanError, match="start"):
         a2ml.rrt_connect(robot, ball, p["start"], p["goals"])
+
+
+def test_obstacles_converted_once_plan_the_same_path() -> None:
+    robot, p = panda(), problem()
+    prepared = a2ml.Obstacles(robot, p["obstacles"])
+    assert len(prepared) == len(p["obstacles"])
+    from_dicts = a2ml.rrt_connect(robot, p["obstacles"], p["start"], p["goals"], seed=5)
+    from_prepared = a2ml.rrt_connect(robot, prepared, p["start"], p["goals"], seed=5)
+    assert np.array_equal(from_prepared["waypoints"], from_dicts["waypoints"])
+    assert from_prepared["collision_checks"] == from_dicts["collision_checks"]
+    # A second robot object of the same URDF builds its own arm model: the same path again.
+    again = a2ml.rrt_connect(panda(), prepared, p["start"], p["goals"], seed=5)
+    assert np.array_equal(again["waypoints"], from_dicts["waypoints"])
+    q = from_dicts["waypoints"][1]
+    assert a2ml.scene_clearance(robot, prepared, q) == a2ml.scene_clearance(robot, p["obstacles"], q)
+
+
+def test_obstacles_refuse_bad_dicts_and_a_robot_rooted_elsewhere() -> None:
+    robot, p = panda(), problem()
+    with pytest.raises(ValueError, match="type"):
+        a2ml.Obstacles(robot, [{"type": "cone", "position": [0, 0, 0]}])
+    prepared = a2ml.Obstacles(robot, p["obstacles"])
+    # The same arm with its URDF root 0.5 m further below the first joint: the obstacles'
+    # positions in {b} would differ.
+    text = (ROOT / "robots" / "panda.urdf").read_text()
+    assert text.count('xyz="0 0 0.333"') == 1
+    lower = a2ml.Robot.from_urdf_string(text.replace('xyz="0 0 0.333"', 'xyz="0 0 0.833"'))
+    with pytest.raises(ValueError, match="converted for a robot"):
+        a2ml.rrt_connect(lower, prepared, p["start"], p["goals"])
+    with pytest.raises(ValueError, match="converted for a robot"):
+        a2ml.scene_clearance(lower, prepared, p["start"])

@@ -23,6 +23,10 @@ pub(crate) struct PyRobot {
     pub(crate) robot: a2ml_core::Robot,
     /// The batched FK kernel of `robot`, built once for every batched call.
     pub(crate) chain: kinematics::BatchedChain,
+    /// The arm's half of the collision model (its shapes, self pairs and their floors, a
+    /// millisecond or more to build for a detailed arm), built at the first planning call and
+    /// shared by every later one.
+    arm: std::sync::OnceLock<a2ml_core::collision::CollisionModel>,
     base: Option<String>,
     tip: Option<String>,
 }
@@ -38,7 +42,15 @@ impl PyRobot {
 
     fn new(robot: a2ml_core::Robot, base: Option<String>, tip: Option<String>) -> Self {
         let chain = kinematics::BatchedChain::new(&robot);
-        Self { robot, chain, base, tip }
+        Self { robot, chain, arm: std::sync::OnceLock::new(), base, tip }
+    }
+
+    /// The arm's collision model ([`PyRobot::arm`]), built on first use.
+    pub(crate) fn arm_model(&self) -> &a2ml_core::collision::CollisionModel {
+        self.arm.get_or_init(|| {
+            let empty = a2ml_core::collision::CollisionScene::new(&[]);
+            a2ml_core::collision::CollisionModel::new(&self.robot, &empty)
+        })
     }
 
     fn options(base: &Option<String>, tip: &Option<String>) -> RobotOptions {

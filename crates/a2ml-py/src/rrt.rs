@@ -1,7 +1,11 @@
 //! `a2ml.rrt_connect` and `a2ml.scene_clearance`: the joint-space RRT-Connect and the
 //! clearance of one configuration among obstacles given as plain dicts in the URDF root frame
-//! (as MoveIt scenes and MotionBenchMaker problems give them), for benchmarks against other
-//! planners (benches/compare/rrt.py). Only conversions here; the planner is the core's.
+//! (as MoveIt scenes and MotionBenchMaker problems give them), or as `a2ml.Obstacles`, the
+//! same dicts converted and checked once for many calls; for benchmarks against other
+//! planners (benches/compare/rrt.py). Only conversions here; the planner is the core's, with
+//! the arm's half of its collision model built once per `Robot`.
+
+use std::borrow::Cow;
 
 use numpy::PyArray2;
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -12,7 +16,7 @@ use a2ml_core::collision::{CollisionScene, check_shapes, min_distance};
 use a2ml_core::kinematics::arm_pose;
 use a2ml_core::language::{Obstacle, Shape};
 use a2ml_core::math::{JointVector, Matrix3, Real, Rotation3, Vector3};
-use a2ml_core::solve::rrt::{RrtOptions, rrt_connect as plan_rrt};
+use a2ml_core::solve::rrt::{RrtOptions, rrt_connect_with};
 
 use crate::convert::{read_array, read_joints, read_vector3};
 use crate::errors::PlanError;
@@ -94,7 +98,7 @@ fn scene(
     robot: &PyRobot,
     obstacles: &Bound<'_, PyAny>,
 ) -> PyResult<(Vec<Obstacle>, CollisionScene)> {
-    let root_to_b = robot.robot.b_from_base_link.translation.vector;
+    let root_to_b = root_to_b(robot);
     let list: Vec<Obstacle> = obstacles
         .try_iter()?
         .enumerate()
@@ -105,8 +109,58 @@ fn scene(
     Ok((list, scene))
 }
 
+/// Obstacle dicts converted into a robot's base frame {b} and checked once, for many planning
+/// calls on one scene: `a2ml.Obstacles(robot, obstacles)`. Usable with any robot whose URDF
+/// root is where `robot`'s is relative to {b}.
+#[pyclass(frozen, module = "a2ml", name = "Obstacles")]
+pub(crate) struct PyObstacles {
+    scene: CollisionScene,
+    /// {b} from the URDF root (a translation) of the robot they were converted for.
+    root_to_b: Vector3,
+}
+
+#[pymethods]
+impl PyObstacles {
+    #[new]
+    fn py_new(robot: &PyRobot, obstacles: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let (_, scene) = scene(robot, obstacles)?;
+        Ok(Self { scene, root_to_b: root_to_b(robot) })
+    }
+
+    fn __len__(&self) -> usize {
+        self.scene.len()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Obstacles({} obstacles)", self.scene.len())
+    }
+}
+
+fn root_to_b(robot: &PyRobot) -> Vector3 {
+    robot.robot.b_from_base_link.translation.vector
+}
+
+/// The scene of `obstacles`: an `a2ml.Obstacles` as it is (refused when converted for a robot
+/// whose root is elsewhere relative to {b}), else an iterable of dicts converted now.
+fn scene_of<'a>(
+    robot: &PyRobot,
+    obstacles: &'a Bound<'_, PyAny>,
+) -> PyResult<Cow<'a, CollisionScene>> {
+    if let Ok(prepared) = obstacles.cast::<PyObstacles>() {
+        let prepared = prepared.get();
+        if prepared.root_to_b != root_to_b(robot) {
+            return Err(PyValueError::new_err(
+                "these Obstacles were converted for a robot whose URDF root is elsewhere \
+                 relative to its base frame; convert them again for this robot",
+            ));
+        }
+        return Ok(Cow::Borrowed(&prepared.scene));
+    }
+    Ok(Cow::Owned(scene(robot, obstacles)?.1))
+}
+
 /// Joint-space RRT-Connect from `start` to any of `goals` among `obstacles` (dicts in the
-/// URDF root frame). Returns a dict: `waypoints` ((N, 7) array), `goal` (index), `samples`,
+/// URDF root frame, or `a2ml.Obstacles`). Returns a dict: `waypoints` ((N, 7) array), `goal` (index), `samples`,
 /// `nodes`, `collision_checks` (no wall time: callers time the call themselves). Raises
 /// `PlanError` when no path is found.
 #[pyfunction]
@@ -126,7 +180,7 @@ pub(crate) fn rrt_connect<'py>(
     resolution: Real,
     shortcuts: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (_, scene) = scene(robot, obstacles)?;
+    let scene = scene_of(robot, obstacles)?;
     let start = read_joints(start, "start")?;
     let goals: Vec<JointVector> =
         goals.try_iter()?.map(|g| read_joints(&g?, "goal")).collect::<PyResult<_>>()?;
@@ -139,9 +193,9 @@ pub(crate) fn rrt_connect<'py>(
         shortcuts,
         ..RrtOptions::default()
     };
-    let core = &robot.robot;
+    let (core, arm) = (&robot.robot, robot.arm_model());
     let path = py
-        .detach(|| plan_rrt(core, &scene, &start, &goals, &options))
+        .detach(|| rrt_connect_with(arm, core, &scene, &start, &goals, &options))
         .map_err(|e| PlanError::new_err(e.to_string()))?;
     let rows: Vec<Vec<Real>> = path.waypoints.iter().map(|q| q.iter().copied().collect()).collect();
     let out = PyDict::new(py);
@@ -154,21 +208,23 @@ pub(crate) fn rrt_connect<'py>(
 }
 
 /// The smallest signed distance (m) between the arm at `q` and `obstacles` (dicts in the URDF
-/// root frame) or between its self-collision pairs; `inf` when there is no pair.
+/// root frame, or `a2ml.Obstacles`) or between its self-collision pairs; `inf` when there is
+/// no pair.
 #[pyfunction]
 pub(crate) fn scene_clearance(
     robot: &PyRobot,
     obstacles: &Bound<'_, PyAny>,
     q: &Bound<'_, PyAny>,
 ) -> PyResult<Real> {
-    let (_, scene) = scene(robot, obstacles)?;
+    let scene = scene_of(robot, obstacles)?;
     let q = read_joints(q, "q")?;
     let pose = arm_pose(&robot.robot, &q);
     Ok(min_distance(&robot.robot, &pose, &scene).map_or(Real::INFINITY, |(d, _, _)| d))
 }
 
-/// Adds [`rrt_connect`] and [`scene_clearance`] to the module.
+/// Adds [`PyObstacles`], [`rrt_connect`] and [`scene_clearance`] to the module.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyObstacles>()?;
     m.add_function(wrap_pyfunction!(rrt_connect, m)?)?;
     m.add_function(wrap_pyfunction!(scene_clearance, m)?)
 }

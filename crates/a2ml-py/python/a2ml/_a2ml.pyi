@@ -47,6 +47,7 @@ __all__ = [
     "decompose",
     "plan",
     "plan_many",
+    "Obstacles",
     "rrt_connect",
     "scene_clearance",
     "Plan",
@@ -963,9 +964,21 @@ def compare(
     """
 
 
+@final
+class Obstacles:
+    """Obstacle dicts converted into the robot's base frame and checked once, for many
+    ``rrt_connect`` and ``scene_clearance`` calls on one scene.
+
+    Each dict as ``rrt_connect`` takes them. Usable with any robot whose URDF root is where
+    ``robot``'s is relative to its base frame (ValueError otherwise).
+    """
+
+    def __new__(cls, robot: Robot, obstacles: Iterable[dict[str, Any]]) -> Obstacles: ...
+    def __len__(self) -> int: ...
+
 def rrt_connect(
     robot: Robot,
-    obstacles: Iterable[dict[str, Any]],
+    obstacles: Obstacles | Iterable[dict[str, Any]],
     start: ArrayLike,
     goals: Iterable[ArrayLike],
     *,
@@ -981,10 +994,14 @@ def rrt_connect(
     Each obstacle: ``type`` (box, sphere, cylinder), ``position``, optional
     ``orientation_quat_xyzw``, and ``half_extents``, ``radius``, ``length``.
     Returns ``waypoints`` ((N, 7) array), ``goal``, ``samples``, ``nodes``,
-    ``collision_checks``; raises PlanError when no path is found.
+    ``collision_checks``; raises PlanError when no path is found. ``Obstacles`` converts a
+    scene once for many calls; the robot builds its arm's collision model (shapes, self
+    pairs) at its first call and keeps it.
     """
 
-def scene_clearance(robot: Robot, obstacles: Iterable[dict[str, Any]], q: ArrayLike) -> float:
+def scene_clearance(
+    robot: Robot, obstacles: Obstacles | Iterable[dict[str, Any]], q: ArrayLike
+) -> float:
     """Smallest signed distance (m) of the arm at q to the obstacles or between its self pairs."""
 
 def swivel_map(

@@ -45,23 +45,30 @@ impl Inflation {
     pub fn set_along(&mut self, model: &CollisionModel, dq: &JointVector, s: Real) {
         let arm = &model.arm;
         let speed = dq.abs() * s;
-        let fill = |out: &mut Vec<Real>, levers: &mut dyn Iterator<Item = &JointVector>| {
-            out.clear();
-            out.extend(levers.map(|l| l.dot(&speed)));
-        };
-        fill(&mut self.links, &mut arm.links.iter().map(|l| &l.levers));
-        fill(&mut self.groups, &mut arm.groups.iter().map(|g| &g.levers));
-        fill(&mut self.group_pairs, &mut arm.group_pairs.iter().map(|p| &p.levers));
-        self.suffixes.clear();
-        self.suffixes.extend(arm.links.iter().map(|link| {
-            let mut suffix = [0.0; DOF];
+        dots(&mut self.links, arm.links.iter().map(|l| &l.levers), &speed);
+        dots(&mut self.groups, arm.groups.iter().map(|g| &g.levers), &speed);
+        dots(&mut self.group_pairs, arm.group_pairs.iter().map(|p| &p.levers), &speed);
+        self.suffixes.resize(arm.links.len(), [0.0; DOF]);
+        for (suffix, link) in self.suffixes.iter_mut().zip(&arm.links) {
             let mut sum = 0.0;
             for j in (0..DOF).rev() {
                 sum += link.levers[j] * speed[j];
                 suffix[j] = sum * RAISE;
             }
-            suffix
-        }));
+        }
+    }
+}
+
+/// `out[k] = levers[k] · speed`, written in place: an edge check sets an [`Inflation`] per
+/// edge, and the lengths are the model's.
+fn dots<'a>(
+    out: &mut Vec<Real>,
+    levers: impl ExactSizeIterator<Item = &'a JointVector>,
+    speed: &JointVector,
+) {
+    out.resize(levers.len(), 0.0);
+    for (o, l) in out.iter_mut().zip(levers) {
+        *o = l.dot(speed);
     }
 }
 
