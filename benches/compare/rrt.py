@@ -21,7 +21,8 @@ The models differ, so each path is also checked in the other's: a2ml's paths by 
 Run in .venv-compare (benches/compare/requirements.txt); a peer that does not import is
 reported as missing, never replaced. The VAMP calls follow vamp-planner 0.6.4's Python API
 (configure_robot_and_planner_with_kwargs, halton, simplify, validate); benches/compare/README.md
-says how it was built offline here. OMPL is not wired in.
+says how it was built offline here. OMPL (the `ompl` wheel's RRTConnect) checks states with
+a2ml's clearance of the 59 spheres from Python, as a user of OMPL's Python bindings would.
 """
 
 from __future__ import annotations
@@ -49,6 +50,13 @@ try:
     import vamp
 except ImportError:
     vamp = None
+
+try:
+    from ompl import base as ompl_base
+    from ompl import geometric as ompl_geometric
+    from ompl import util as ompl_util
+except ImportError:
+    ompl_base = None
 
 
 def euler_xyz(q: list[float]) -> list[float]:
@@ -134,13 +142,72 @@ class A2ml:
         return time.perf_counter() - start, result["waypoints"]
 
     def valid_path(self, problem, obstacles, waypoints) -> bool:
-        """a2ml's exact clearance stays ≥ 0 at 1 mm of arm motion (1.5 m of lever per rad)."""
-        for a, b in zip(waypoints[:-1], waypoints[1:]):
-            steps = max(1, math.ceil(np.abs(b - a).sum() * 1.5 / 1e-3))
-            for k in range(steps + 1):
-                if a2ml.scene_clearance(self.robot, obstacles, a + (b - a) * k / steps) < 0:
-                    return False
-        return True
+        return a2ml_valid_path(self.robot, obstacles, waypoints)
+
+
+class Ompl:
+    """OMPL's RRTConnect with the state validity checker a Python user would write: a2ml's
+    clearance of the 59-sphere Panda (`a2ml.scene_clearance`, ≥ 0: VAMP's criterion) at each
+    state OMPL asks about, OMPL's own discrete motion check along edges (its default
+    resolution) and `simplifySolution`; a wall-clock limit per problem (OMPL has no sample
+    budget), a problem not solved within it counting as unsolved."""
+
+    name = "ompl"
+
+    def __init__(self, time_limit: float):
+        ompl_util.setLogLevel(ompl_util.LogLevel.LOG_ERROR)
+        self.robot = a2ml.Robot.from_urdf(MODELS["spheres"])
+        self.time_limit = time_limit
+        self.space = ompl_base.RealVectorStateSpace(7)
+        bounds = ompl_base.RealVectorBounds(7)
+        for i, (low, high) in enumerate(zip(self.robot.lower(), self.robot.upper())):
+            bounds.setLow(i, float(low))
+            bounds.setHigh(i, float(high))
+        self.space.setBounds(bounds)
+
+    def prepare(self, problem, scene):
+        return a2ml.Obstacles(self.robot, problem["obstacles"])
+
+    def plan(self, problem, obstacles):
+        robot = self.robot
+        setup = ompl_geometric.SimpleSetup(self.space)
+        setup.setStateValidityChecker(
+            lambda s: a2ml.scene_clearance(robot, obstacles, [s[i] for i in range(7)]) >= 0)
+        goals = ompl_base.GoalStates(setup.getSpaceInformation())
+        for g in problem["goals"]:
+            state = self.space.allocState()
+            for i in range(7):
+                state[i] = g[i]
+            goals.addState(state)
+        start = self.space.allocState()
+        for i in range(7):
+            start[i] = problem["start"][i]
+        setup.setStartState(start)
+        setup.setGoal(goals)
+        setup.setPlanner(ompl_geometric.RRTConnect(setup.getSpaceInformation()))
+        began = time.perf_counter()
+        solved = setup.solve(self.time_limit)
+        if not setup.haveExactSolutionPath():
+            return time.perf_counter() - began, None
+        setup.simplifySolution()
+        elapsed = time.perf_counter() - began
+        path = setup.getSolutionPath()
+        waypoints = [[path.getState(k)[i] for i in range(7)] for k in range(path.getStateCount())]
+        del solved
+        return elapsed, np.asarray(waypoints, dtype=float)
+
+    def valid_path(self, problem, obstacles, waypoints) -> bool:
+        return a2ml_valid_path(self.robot, obstacles, waypoints)
+
+
+def a2ml_valid_path(robot, obstacles, waypoints) -> bool:
+    """a2ml's exact clearance stays ≥ 0 at 1 mm of arm motion (1.5 m of lever per rad)."""
+    for a, b in zip(waypoints[:-1], waypoints[1:]):
+        steps = max(1, math.ceil(np.abs(b - a).sum() * 1.5 / 1e-3))
+        for k in range(steps + 1):
+            if a2ml.scene_clearance(robot, obstacles, a + (b - a) * k / steps) < 0:
+                return False
+    return True
 
 
 def run_scene(name, planners, count, rounds):
@@ -185,6 +252,8 @@ def main():
     parser.add_argument("--scenes", default=",".join(SCENES))
     parser.add_argument("--problems", type=int, default=100)
     parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--ompl-time", type=float, default=5.0,
+                        help="OMPL's wall-clock limit per problem (s); 0 leaves OMPL out")
     args = parser.parse_args()
     planners = [A2ml("capsules"), A2ml("spheres"), A2ml("spheres", clearance=0.0)]
     compared = [p.name for p in planners if p.name.startswith("a2ml/spheres")]
@@ -192,23 +261,26 @@ def main():
         print("vamp-planner does not import here: a2ml alone, no ratio")
     else:
         planners.append(Vamp())
+    if ompl_base is None:
+        print("ompl does not import here: no OMPL column")
+    elif args.ompl_time > 0:
+        planners.append(Ompl(args.ompl_time))
     print(f"{datetime.date.today()} {platform.machine()} {platform.processor() or ''} "
           f"{len(planners)} planners, {args.rounds} rounds, paired medians")
+    names = [p.name for p in planners]
+    pairs = [(a, peer) for peer in ("vamp", "ompl") if peer in names for a in compared]
     header = "| scene | " + " | ".join(f"{p.name} median, solved" for p in planners)
-    if vamp is not None:
-        header += "".join(f" | {name} ÷ vamp" for name in compared)
+    header += "".join(f" | {a} ÷ {peer}" for a, peer in pairs)
     print(header + " |")
     for name in args.scenes.split(","):
         rows = run_scene(name, planners, args.problems, args.rounds)
         cells = [f"{rows[p.name]['median'] * 1e3:.3f} ms, {rows[p.name]['solved']}"
                  for p in planners]
-        if vamp is not None:
-            v = rows["vamp"]["medians"]
-            for compared_name in compared:
-                a = rows[compared_name]["medians"]
-                ratios = [a[i] / v[i] for i in a if i in v]
-                cells.append(f"{statistics.median(ratios):.2f}" if ratios else "-")
-        print(f"| {name} | " + " | ".join(cells) + " |")
+        for a_name, peer in pairs:
+            a, v = rows[a_name]["medians"], rows[peer]["medians"]
+            ratios = [a[i] / v[i] for i in a if i in v]
+            cells.append(f"{statistics.median(ratios):.2f}" if ratios else "-")
+        print(f"| {name} | " + " | ".join(cells) + " |", flush=True)
         for p in planners:
             for other, (valid, found) in rows[p.name]["valid_in"].items():
                 print(f"    {name}: {p.name} paths valid in {other}'s model: {valid} of {found}")

@@ -467,10 +467,12 @@ impl JointSpace<'_> {
     /// not keep the clearance even uninflated is a configuration of the edge within it, and
     /// the edge is blocked. So `Some(true)` only when the checks cover the whole edge.
     ///
-    /// The new end b is checked first (the likelier to collide), then the points between in
-    /// bisection order, then a (where the edge leaves the tree: clear itself, so only what its
-    /// check covers is in question), and the halvings last, so that a blocked edge is found
-    /// after few checks.
+    /// The points between are checked first, in bisection order (the middle first: on the
+    /// MotionBenchMaker scenes a blocked edge is more often blocked there than at its new end;
+    /// in the cage, of the blocked edges, 29 % were found at b and 50 % at the middle checked
+    /// after it), then the new end b, then a (where the edge leaves the tree: clear itself, so
+    /// only what its check covers is in question), and the halvings last, so that a blocked
+    /// edge is found after few checks.
     fn discrete_edge(
         &mut self,
         a: &JointVector,
@@ -488,9 +490,7 @@ impl JointSpace<'_> {
         self.halves.clear();
         let (mut end_b, mut end_a) = (true, true);
         loop {
-            let (t, level) = if std::mem::take(&mut end_b) {
-                (1.0, 0)
-            } else if let Some((first, last)) = self.stretches.pop_front() {
+            let (t, level) = if let Some((first, last)) = self.stretches.pop_front() {
                 if last - first < 2 {
                     continue;
                 }
@@ -498,6 +498,8 @@ impl JointSpace<'_> {
                 self.stretches.push_back((first, middle));
                 self.stretches.push_back((middle, last));
                 (middle as Real / n as Real, 0)
+            } else if std::mem::take(&mut end_b) {
+                (1.0, 0)
             } else if std::mem::take(&mut end_a) {
                 (0.0, 0)
             } else if let Some(half) = self.halves.pop_front() {
