@@ -160,7 +160,7 @@ class Ompl:
         self.time_limit = time_limit
         self.space = ompl_base.RealVectorStateSpace(7)
         bounds = ompl_base.RealVectorBounds(7)
-        for i, (low, high) in enumerate(zip(self.robot.lower(), self.robot.upper())):
+        for i, (low, high) in enumerate(zip(self.robot.lower, self.robot.upper)):
             bounds.setLow(i, float(low))
             bounds.setHigh(i, float(high))
         self.space.setBounds(bounds)
