@@ -186,14 +186,13 @@ class Ompl:
         setup.setGoal(goals)
         setup.setPlanner(ompl_geometric.RRTConnect(setup.getSpaceInformation()))
         began = time.perf_counter()
-        solved = setup.solve(self.time_limit)
+        setup.solve(self.time_limit)
         if not setup.haveExactSolutionPath():
             return time.perf_counter() - began, None
         setup.simplifySolution()
         elapsed = time.perf_counter() - began
         path = setup.getSolutionPath()
         waypoints = [[path.getState(k)[i] for i in range(7)] for k in range(path.getStateCount())]
-        del solved
         return elapsed, np.asarray(waypoints, dtype=float)
 
     def valid_path(self, problem, obstacles, waypoints) -> bool:

@@ -93,20 +93,21 @@ fn obstacle(index: usize, item: &Bound<'_, PyAny>, root_to_b: &Vector3) -> PyRes
     Ok(Obstacle { name, shape })
 }
 
-/// The obstacles in {b}, each shape checked as planning checks it.
-fn scene(
-    robot: &PyRobot,
-    obstacles: &Bound<'_, PyAny>,
-) -> PyResult<(Vec<Obstacle>, CollisionScene)> {
+/// The obstacles in {b}, each shape (and the robot's capsules) checked as planning checks it.
+fn scene(robot: &PyRobot, obstacles: &Bound<'_, PyAny>) -> PyResult<CollisionScene> {
     let root_to_b = root_to_b(robot);
     let list: Vec<Obstacle> = obstacles
         .try_iter()?
         .enumerate()
         .map(|(i, item)| obstacle(i, &item?, &root_to_b))
         .collect::<PyResult<_>>()?;
-    check_shapes(&robot.robot, &list).map_err(|e| PyValueError::new_err(e.to_string()))?;
-    let scene = CollisionScene::new(&list);
-    Ok((list, scene))
+    checked(robot, &list)?;
+    Ok(CollisionScene::new(&list))
+}
+
+/// [`check_shapes`] of `robot`'s capsules and `obstacles`, as a ValueError.
+fn checked(robot: &PyRobot, obstacles: &[Obstacle]) -> PyResult<()> {
+    check_shapes(&robot.robot, obstacles).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
 /// Obstacle dicts converted into a robot's base frame {b} and checked once, for many planning
@@ -123,8 +124,7 @@ pub(crate) struct PyObstacles {
 impl PyObstacles {
     #[new]
     fn py_new(robot: &PyRobot, obstacles: &Bound<'_, PyAny>) -> PyResult<Self> {
-        let (_, scene) = scene(robot, obstacles)?;
-        Ok(Self { scene, root_to_b: root_to_b(robot) })
+        Ok(Self { scene: scene(robot, obstacles)?, root_to_b: root_to_b(robot) })
     }
 
     fn __len__(&self) -> usize {
@@ -141,7 +141,9 @@ fn root_to_b(robot: &PyRobot) -> Vector3 {
 }
 
 /// The scene of `obstacles`: an `a2ml.Obstacles` as it is (refused when converted for a robot
-/// whose root is elsewhere relative to {b}), else an iterable of dicts converted now.
+/// whose root is elsewhere relative to {b}; the obstacles were checked when converted, this
+/// robot's capsules are checked now, as they may be another robot's), else an iterable of
+/// dicts converted now.
 fn scene_of<'a>(
     robot: &PyRobot,
     obstacles: &'a Bound<'_, PyAny>,
@@ -154,15 +156,17 @@ fn scene_of<'a>(
                  relative to its base frame; convert them again for this robot",
             ));
         }
+        checked(robot, &[])?;
         return Ok(Cow::Borrowed(&prepared.scene));
     }
-    Ok(Cow::Owned(scene(robot, obstacles)?.1))
+    Ok(Cow::Owned(scene(robot, obstacles)?))
 }
 
 /// Joint-space RRT-Connect from `start` to any of `goals` among `obstacles` (dicts in the
-/// URDF root frame, or `a2ml.Obstacles`). Returns a dict: `waypoints` ((N, 7) array), `goal` (index), `samples`,
-/// `nodes`, `collision_checks` (no wall time: callers time the call themselves). Raises
-/// `PlanError` when no path is found.
+/// URDF root frame, or `a2ml.Obstacles`). Returns a dict: `waypoints` ((N, 7) array), `goal`
+/// (index), `samples`, `nodes`, `collision_checks` (no wall time: callers time the call
+/// themselves). Raises `PlanError` when no path is found. The robot's arm model is built at
+/// its first call, without the GIL.
 #[pyfunction]
 #[pyo3(signature = (robot, obstacles, start, goals, *, seed = 0, clearance = 0.01,
     max_samples = 20_000, step = 2.0, resolution = 0.005, shortcuts = 200))]
@@ -193,9 +197,10 @@ pub(crate) fn rrt_connect<'py>(
         shortcuts,
         ..RrtOptions::default()
     };
-    let (core, arm) = (&robot.robot, robot.arm_model());
     let path = py
-        .detach(|| rrt_connect_with(arm, core, &scene, &start, &goals, &options))
+        .detach(|| {
+            rrt_connect_with(robot.arm_model(), &robot.robot, &scene, &start, &goals, &options)
+        })
         .map_err(|e| PlanError::new_err(e.to_string()))?;
     let rows: Vec<Vec<Real>> = path.waypoints.iter().map(|q| q.iter().copied().collect()).collect();
     let out = PyDict::new(py);
