@@ -132,3 +132,52 @@ fn edges_the_inflated_checks_call_clear_are_clear() {
         }
     }
 }
+
+/// An inflation halved k times in place ([`Inflation::set_halvings`]) answers as one set along
+/// the motion over 2^-k of the units, verdict for verdict, in both arm models, where the
+/// verdicts of the halvings differ (so the factor is used, not only carried).
+#[test]
+fn a_halved_inflation_answers_as_one_set_over_the_halved_stretch() {
+    let spheres = Robot::from_urdf_file(format!(
+        "{}/tests/data/panda_spheres/panda_spheres.urdf",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .expect("robot loads");
+    let mut rng = rng(23);
+    for (model_name, robot) in [("spheres", spheres), ("capsules", load("panda"))] {
+        let (lower, upper) = (robot.lower(), robot.upper());
+        let mut differing = 0;
+        for (s, scene_name) in SCENES.iter().enumerate() {
+            let problem = &problems(scene_name)[s];
+            let scene = CollisionScene::new(&problem.obstacles);
+            let model = CollisionModel::new(&robot, &scene);
+            let margin = if s % 2 == 0 { 0.0 } else { 0.01 };
+            for _ in 0..100 {
+                let q = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+                let towards = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+                let dq = towards - q;
+                let units = rng.random_range(0.01..0.5);
+                let mut halved = Inflation::along(&model, &dq, units);
+                let mut seen = Vec::new();
+                for k in 0..8 {
+                    halved.set_halvings(k);
+                    let fresh = Inflation::along(&model, &dq, units / (1 << k) as Real);
+                    let found = verdict(&model, &q, margin, &halved);
+                    assert_eq!(
+                        found,
+                        verdict(&model, &q, margin, &fresh),
+                        "{model_name}/{scene_name}: {k} halvings at {q:?}"
+                    );
+                    assert_eq!(
+                        is_clear(&model, &q, margin, &halved),
+                        is_clear(&model, &q, margin, &fresh),
+                        "{model_name}/{scene_name}: {k} halvings at {q:?}"
+                    );
+                    seen.push(found);
+                }
+                differing += usize::from(seen.iter().any(|&v| v != seen[0]));
+            }
+        }
+        assert!(differing > 5, "{model_name}: {differing} configurations with differing verdicts");
+    }
+}

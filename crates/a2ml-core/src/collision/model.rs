@@ -126,8 +126,45 @@ const ROUNDING: Real = 1e-12;
 
 impl Convex {
     /// The signed distance from `p` to the solid (negative inside: the depth).
+    #[inline]
     fn point_distance(&self, p: &Vector3) -> Real {
-        let local = self.rotation.tr_mul(&(p - self.body.center));
+        self.local_point_distance(&self.local(p))
+    }
+
+    /// `frame` (an arm frame in {b}) seen from the solid's own axes about its centre: a point
+    /// of the frame is placed there by one product ([`Convex::local`] of the frame's point).
+    #[inline]
+    fn frame_in_axes(&self, frame: &Frame) -> Frame {
+        Frame {
+            rotation: self.rotation.tr_mul(&frame.rotation),
+            translation: self.local(&frame.translation),
+        }
+    }
+
+    /// [`Convex::local_point_distance`] when below `below`, `None` when not: outside, the
+    /// squared distance is compared first, so that a clear point costs no square root.
+    #[inline]
+    fn local_point_distance_below(&self, local: &Vector3, below: Real) -> Option<Real> {
+        if let Solid::Cuboid { half } = self.solid {
+            // Component by component: nalgebra's generic reductions cost several times more
+            // in this, the innermost test of a collision check.
+            let (x, y, z) =
+                (local.x.abs() - half.x, local.y.abs() - half.y, local.z.abs() - half.z);
+            let deepest = x.max(y).max(z);
+            if deepest <= 0.0 {
+                return (deepest < below).then_some(deepest);
+            }
+            let (x, y, z) = (x.max(0.0), y.max(0.0), z.max(0.0));
+            let squared = x * x + y * y + z * z;
+            return (below > 0.0 && squared < below * below).then(|| squared.sqrt());
+        }
+        Some(self.local_point_distance(local)).filter(|&distance| distance < below)
+    }
+
+    /// [`Convex::point_distance`] of a point in the solid's own axes ([`Convex::local`]).
+    #[inline]
+    fn local_point_distance(&self, local: &Vector3) -> Real {
+        let local = *local;
         match self.solid {
             Solid::Cuboid { half } => {
                 let d = local.abs() - half;
@@ -385,6 +422,8 @@ struct LinkCapsule {
     /// The midpoint of a–b (aligned frame), and the radius of the bounding sphere about it.
     center: Vector3,
     bound: Real,
+    /// Whether the segment is a point (a sphere): its distances need no segment.
+    point: bool,
     /// Per joint, how far any point of the segment can be from the joint's axis (m), over all
     /// configurations: the segment moves at most Σ levers_j |Δq_j| along a straight
     /// joint-space motion Δq.
@@ -546,6 +585,7 @@ impl Arm {
                     radius: c.radius,
                     center: 0.5 * (a + b),
                     bound: 0.5 * (b - a).norm() + c.radius,
+                    point: a == b,
                     levers: levers(robot, c.frame, &c.a, &c.b),
                 }
             })
@@ -656,6 +696,7 @@ impl Arm {
                 start: p.joints.start,
                 bounds: p.bounds,
                 floor: p.floor,
+                points: links[p.link].point && links[p.other].point,
             })
             .collect();
         let moving = (0..robot.capsules.len())
@@ -818,7 +859,21 @@ impl CollisionModel {
                 {
                     continue;
                 }
+                // The group's frame in the solid's axes, where its spheres are placed directly.
+                let mut in_axes: Option<Frame> = None;
                 for m in 0..n {
+                    let capsule = &self.arm.links[group.members[m]];
+                    if capsule.point {
+                        let frame = in_axes
+                            .get_or_insert_with(|| convex.frame_in_axes(&frames[group.frame]));
+                        let local = frame.apply(&capsule.a);
+                        if let Some(distance) = convex.local_point_distance_below(&local, below[m])
+                        {
+                            below[m] = distance;
+                            found[m] = true;
+                        }
+                        continue;
+                    }
                     let link = posed[m].get_or_insert_with(|| place(m));
                     let gap = (link.center - body.center).norm() - link.bound - body.bound;
                     if gap >= below[m] - link.radius {
@@ -991,6 +1046,9 @@ struct HotPair {
     start: usize,
     bounds: Real,
     floor: Real,
+    /// Both capsules are points: the distance of their bounding spheres (`bounds` apart) is
+    /// theirs.
+    points: bool,
 }
 
 /// The first [`Placed::CAPACITY`] capsules placed at most once per query, on the stack; the
@@ -1036,6 +1094,7 @@ impl Centers {
         Self { placed: 0, slots: [Vector3::zeros(); Self::CAPACITY] }
     }
 
+    #[inline]
     fn get(&mut self, i: usize, links: &[LinkCapsule], frames: &[Frame; DOF + 1]) -> Vector3 {
         let place = || frames[links[i].frame].apply(&links[i].center);
         if i >= Self::CAPACITY {

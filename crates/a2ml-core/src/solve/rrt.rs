@@ -315,9 +315,9 @@ struct JointSpace<'a> {
     model: CollisionModel,
     /// Uncovered stretches of the edge being checked (reused, to allocate once).
     gaps: Vec<Gap>,
-    /// The shapes' inflations for the discrete checks of the edge being checked (per halving
-    /// of their stretch).
-    levels: Vec<Inflation>,
+    /// The shapes' inflation for the discrete checks of the edge being checked, halved with
+    /// their stretch ([`Inflation::set_halvings`]); made at the first edge.
+    inflation: Option<Inflation>,
     /// Stretches (first, last check point) of the discrete checks still to split, and the
     /// halved checks (parameter, halvings) still to make (reused).
     stretches: VecDeque<(usize, usize)>,
@@ -350,7 +350,7 @@ impl<'a> JointSpace<'a> {
             robot,
             scene,
             options,
-            levels: Vec::new(),
+            inflation: None,
             model,
             gaps: Vec::new(),
             stretches: VecDeque::new(),
@@ -483,8 +483,13 @@ impl JointSpace<'_> {
         let n = (travel / self.options.spacing).ceil().max(1.0);
         let half = 0.5 / n;
         let n = n as usize;
-        // The inflations of the halvings are made when first needed.
-        let mut levels = 0;
+        let inflation = match &mut self.inflation {
+            Some(inflation) => {
+                inflation.set_along(&self.model, dq, half);
+                inflation
+            }
+            None => self.inflation.insert(Inflation::along(&self.model, dq, half)),
+        };
         self.stretches.clear();
         self.stretches.push_back((0, n));
         self.halves.clear();
@@ -507,19 +512,12 @@ impl JointSpace<'_> {
             } else {
                 return Some(true);
             };
-            while levels <= level {
-                let h = half / (1 << levels) as Real;
-                match self.levels.get_mut(levels) {
-                    Some(inflation) => inflation.set_along(&self.model, dq, h),
-                    None => self.levels.push(Inflation::along(&self.model, dq, h)),
-                }
-                levels += 1;
-            }
+            inflation.set_halvings(level as i32);
             let q = if t == 1.0 { *b } else { a + dq * t };
             // One pass tells both whether the inflated shapes keep the clearance and, where
             // not, whether the shapes themselves do.
             self.checks += 1;
-            match verdict(&self.model, &q, self.options.clearance, &self.levels[level]) {
+            match verdict(&self.model, &q, self.options.clearance, inflation) {
                 Verdict::Clear => continue,
                 Verdict::Blocked => return Some(false),
                 Verdict::Tight => {}
@@ -540,7 +538,7 @@ impl JointSpace<'_> {
 
 /// How many times a discrete check's stretch is halved where its inflated shapes come within
 /// the clearance, before the edge is left to the covering checks.
-const REFINEMENTS: usize = 3;
+const REFINEMENTS: usize = 6;
 
 /// A node of a joint-space tree: its configuration, and for a goal tree's root which goal it
 /// is.

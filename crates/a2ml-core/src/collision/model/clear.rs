@@ -4,6 +4,7 @@
 //! of sampling planners.
 
 use super::{ALL_MEMBERS, Centers, CollisionModel, GROUP_SIZE, Posed, ROUNDING};
+use crate::kinematics::Frame;
 use crate::math::{DOF, JointVector, Real, segment_segment_distance};
 
 /// How much each shape of a [`CollisionModel`] is inflated in [`is_clear`] (m): per arm capsule,
@@ -18,6 +19,9 @@ pub struct Inflation {
     /// the joints between the two frames, and a capsule's are zero past its frame).
     suffixes: Vec<[Real; DOF]>,
     group_pairs: Vec<Real>,
+    /// What every value above is multiplied by when used: 2^−k after
+    /// [`Inflation::set_halvings`], 1 otherwise.
+    factor: Real,
 }
 
 impl Inflation {
@@ -29,6 +33,7 @@ impl Inflation {
             groups: vec![0.0; arm.groups.len()],
             suffixes: vec![[0.0; DOF]; arm.links.len()],
             group_pairs: vec![0.0; arm.group_pairs.len()],
+            factor: 1.0,
         }
     }
 
@@ -44,6 +49,7 @@ impl Inflation {
     /// [`Inflation::along`] in place, for `model` (the one it was made for).
     pub fn set_along(&mut self, model: &CollisionModel, dq: &JointVector, s: Real) {
         let arm = &model.arm;
+        self.factor = 1.0;
         let speed = dq.abs() * s;
         dots(&mut self.links, arm.links.iter().map(|l| &l.levers), &speed);
         dots(&mut self.groups, arm.groups.iter().map(|g| &g.levers), &speed);
@@ -56,6 +62,17 @@ impl Inflation {
                 suffix[j] = sum * RAISE;
             }
         }
+    }
+}
+
+impl Inflation {
+    /// The inflation last set along `dq` over `s` units ([`Inflation::set_along`]) made that of
+    /// `s / 2^halvings` units, for the price of one number: a power of two scales every product
+    /// and sum of it exactly, so [`is_clear`] and [`verdict`] answer bit for bit as after
+    /// `set_along(model, dq, s / 2^halvings)`. The edge checks halve a stretch's inflation
+    /// several times.
+    pub fn set_halvings(&mut self, halvings: i32) {
+        self.factor = (0.5 as Real).powi(halvings);
     }
 }
 
@@ -140,9 +157,11 @@ fn scan(
     let frames = arm.chain.frames(q);
     // Distances are compared with this raised by a shape's inflation (and its radius).
     let limit = clearance + ROUNDING;
-    // 1 while the shapes are inflated; 0 once a pair came within the inflated clearance and
-    // the rest of the pass looks for a pair within the plain one.
-    let mut scale: Real = 1.0;
+    // The inflation's factor while the shapes are inflated; 0 once a pair came within the
+    // inflated clearance (`tight`) and the rest of the pass looks for a pair within the plain
+    // one.
+    let mut scale: Real = inflation.factor;
+    let mut tight = false;
     // A pair at `distance` (a lower bound) below `keep`, the inflated clearance, whose plain
     // clearance is `plain`: the pass ends (not settling, or a collision), or goes on uninflated.
     macro_rules! violated {
@@ -151,6 +170,7 @@ fn scan(
                 return Verdict::Blocked;
             }
             scale = 0.0;
+            tight = true;
         }};
     }
     for (g, group) in arm.groups.iter().enumerate() {
@@ -197,13 +217,25 @@ fn scan(
         for convex in &model.convex {
             let body = &convex.body;
             if (center - body.center).norm() - body.bound >= near
-                || convex.point_distance(&center) >= near
+                || convex.local_point_distance_below(&convex.local(&center), near).is_none()
             {
                 continue;
             }
+            // The group's frame in the solid's axes, where its spheres are placed directly.
+            let mut in_axes: Option<Frame> = None;
             for (m, slot) in posed.iter_mut().enumerate().take(group.members.len()) {
-                let link = slot.get_or_insert_with(|| place(m));
                 let inflated = keep(m, scale);
+                let capsule = &arm.links[group.members[m]];
+                if capsule.point {
+                    let frame =
+                        in_axes.get_or_insert_with(|| convex.frame_in_axes(&frames[group.frame]));
+                    let local = frame.apply(&capsule.a);
+                    if let Some(distance) = convex.local_point_distance_below(&local, inflated) {
+                        violated!(distance, keep(m, 0.0));
+                    }
+                    continue;
+                }
+                let link = slot.get_or_insert_with(|| place(m));
                 // A lower bound of the segment's distance, when below the inflated clearance.
                 // A point's distance is as cheap as a bounding-sphere test, and exact.
                 if link.inverse_squared_length == 0.0 {
@@ -279,12 +311,16 @@ fn scan(
             if gap.norm_squared() >= reach * reach {
                 continue;
             }
-            let (link, other) = (&arm.links[pair.link], &arm.links[pair.other]);
-            let distance = link.posed(&frames).distance(&other.posed(&frames));
+            let distance = if pair.points {
+                gap.norm() - pair.bounds
+            } else {
+                let (link, other) = (&arm.links[pair.link], &arm.links[pair.other]);
+                link.posed(&frames).distance(&other.posed(&frames))
+            };
             if distance < keep {
                 violated!(distance, limit);
             }
         }
     }
-    if scale == 1.0 { Verdict::Clear } else { Verdict::Tight }
+    if tight { Verdict::Tight } else { Verdict::Clear }
 }
