@@ -2,20 +2,13 @@
 //! Panda, tests/data/panda_spheres): every clearance plans, and every path is re-checked
 //! densely and independently.
 
-use a2ml::Robot;
 use a2ml::collision::{CollisionModel, CollisionScene, advancement, clearance, min_distance};
 use a2ml::kinematics::arm_pose;
 use a2ml::language::{Obstacle, Shape};
 use a2ml::math::{JointVector, Real, Vector3};
 use a2ml::solve::rrt::{RrtError, RrtOptions, rrt_connect};
 
-use crate::common::{random_q, rng};
-
-fn sphere_panda() -> Robot {
-    let path =
-        format!("{}/tests/data/panda_spheres/panda_spheres.urdf", env!("CARGO_MANIFEST_DIR"));
-    Robot::from_urdf_file(path).expect("the sphere Panda loads")
-}
+use crate::common::{random_q, rng, sphere_panda};
 
 /// Instance 0 of tests/data/panda_sphere_cage.json in {b} (S is 0.333 m above the root).
 fn cage() -> (JointVector, JointVector, Vec<Obstacle>) {

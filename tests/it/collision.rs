@@ -1,6 +1,6 @@
 //! Capsule-obstacle distances against independent brute force.
 
-use crate::common::{all_robots, load, random_q, rng};
+use crate::common::{all_robots, load, random_q, rng, sphere_panda};
 use a2ml::collision::*;
 use a2ml::kinematics::arm_pose;
 use a2ml::language::{Obstacle, Shape};
@@ -312,15 +312,7 @@ fn advancement_keeps_the_clearance_either_way() {
 /// Both Panda models of the MotionBenchMaker comparison: capsules with the hand, and VAMP's
 /// 59 spheres.
 fn mbm_models() -> Vec<(&'static str, a2ml::Robot)> {
-    let path = |p: &str| format!("{}/{p}", env!("CARGO_MANIFEST_DIR"));
-    vec![
-        ("capsules", load("panda")),
-        (
-            "spheres",
-            a2ml::Robot::from_urdf_file(path("tests/data/panda_spheres/panda_spheres.urdf"))
-                .expect("robot loads"),
-        ),
-    ]
+    vec![("capsules", load("panda")), ("spheres", sphere_panda())]
 }
 
 /// On the MotionBenchMaker scenes (thin shelves, rotated boxes and cylinders), the collision

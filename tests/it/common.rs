@@ -15,6 +15,13 @@ pub fn load(name: &str) -> Robot {
     Robot::from_urdf_file(robot_path(name)).expect("robot loads")
 }
 
+/// VAMP's 59-sphere Panda (tests/data/panda_spheres), the MotionBenchMaker comparison's model.
+pub fn sphere_panda() -> Robot {
+    let path =
+        format!("{}/tests/data/panda_spheres/panda_spheres.urdf", env!("CARGO_MANIFEST_DIR"));
+    Robot::from_urdf_file(path).expect("the sphere Panda loads")
+}
+
 pub fn all_robots() -> Vec<(&'static str, Robot)> {
     ROBOTS.iter().map(|n| (*n, load(n))).collect()
 }

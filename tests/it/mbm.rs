@@ -1,7 +1,6 @@
 //! The seven MotionBenchMaker scenes (tests/data/mbm): rotated boxes and cylinders read into
 //! a scene, and joint-space RRT paths among them re-checked densely and independently.
 
-use a2ml::Robot;
 use a2ml::collision::{
     CollisionModel, CollisionScene, Inflation, Verdict, clearance, is_clear, min_distance,
     motion_bound, verdict,
@@ -12,7 +11,7 @@ use a2ml::math::{JointVector, Matrix3, Real};
 use a2ml::solve::rrt::{RrtError, RrtOptions, rrt_connect};
 use rand::RngExt;
 
-use crate::common::{load, rng};
+use crate::common::{load, rng, sphere_panda};
 use crate::mbm_problems::{SCENES, problems};
 
 #[test]
@@ -66,11 +65,7 @@ fn motion_bench_maker_paths_keep_the_clearance() {
 /// two checks.
 #[test]
 fn edges_the_inflated_checks_call_clear_are_clear() {
-    let spheres = Robot::from_urdf_file(format!(
-        "{}/tests/data/panda_spheres/panda_spheres.urdf",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .expect("robot loads");
+    let spheres = sphere_panda();
     let mut rng = rng(22);
     for (model_name, robot) in [("spheres", spheres), ("capsules", load("panda"))] {
         let (lower, upper) = (robot.lower(), robot.upper());
@@ -138,11 +133,7 @@ fn edges_the_inflated_checks_call_clear_are_clear() {
 /// verdicts of the halvings differ (so the factor is used, not only carried).
 #[test]
 fn a_halved_inflation_answers_as_one_set_over_the_halved_stretch() {
-    let spheres = Robot::from_urdf_file(format!(
-        "{}/tests/data/panda_spheres/panda_spheres.urdf",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .expect("robot loads");
+    let spheres = sphere_panda();
     let mut rng = rng(23);
     for (model_name, robot) in [("spheres", spheres), ("capsules", load("panda"))] {
         let (lower, upper) = (robot.lower(), robot.upper());

@@ -316,8 +316,8 @@ struct JointSpace<'a> {
     /// Uncovered stretches of the edge being checked (reused, to allocate once).
     gaps: Vec<Gap>,
     /// The shapes' inflation for the discrete checks of the edge being checked, halved with
-    /// their stretch ([`Inflation::set_halvings`]); made at the first edge.
-    inflation: Option<Inflation>,
+    /// their stretch ([`Inflation::set_halvings`]; reused, to allocate once).
+    inflation: Inflation,
     /// Stretches (first, last check point) of the discrete checks still to split, and the
     /// halved checks (parameter, halvings) still to make (reused).
     stretches: VecDeque<(usize, usize)>,
@@ -350,7 +350,7 @@ impl<'a> JointSpace<'a> {
             robot,
             scene,
             options,
-            inflation: None,
+            inflation: Inflation::none(&model),
             model,
             gaps: Vec::new(),
             stretches: VecDeque::new(),
@@ -483,13 +483,7 @@ impl JointSpace<'_> {
         let n = (travel / self.options.spacing).ceil().max(1.0);
         let half = 0.5 / n;
         let n = n as usize;
-        let inflation = match &mut self.inflation {
-            Some(inflation) => {
-                inflation.set_along(&self.model, dq, half);
-                inflation
-            }
-            None => self.inflation.insert(Inflation::along(&self.model, dq, half)),
-        };
+        self.inflation.set_along(&self.model, dq, half);
         self.stretches.clear();
         self.stretches.push_back((0, n));
         self.halves.clear();
@@ -512,12 +506,12 @@ impl JointSpace<'_> {
             } else {
                 return Some(true);
             };
-            inflation.set_halvings(level as i32);
+            self.inflation.set_halvings(level as i32);
             let q = if t == 1.0 { *b } else { a + dq * t };
             // One pass tells both whether the inflated shapes keep the clearance and, where
             // not, whether the shapes themselves do.
             self.checks += 1;
-            match verdict(&self.model, &q, self.options.clearance, inflation) {
+            match verdict(&self.model, &q, self.options.clearance, &self.inflation) {
                 Verdict::Clear => continue,
                 Verdict::Blocked => return Some(false),
                 Verdict::Tight => {}
