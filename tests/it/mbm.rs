@@ -2,8 +2,8 @@
 //! a scene, and joint-space RRT paths among them re-checked densely and independently.
 
 use a2ml::collision::{
-    CollisionModel, CollisionScene, Inflation, Verdict, clearance, is_clear, min_distance,
-    motion_bound, verdict,
+    CollisionModel, CollisionScene, Inflation, Pairs, Verdict, clearance, is_clear, min_distance,
+    motion_bound, self_motion_bound, verdict, verdict_of,
 };
 use a2ml::kinematics::arm_pose;
 use a2ml::language::Shape;
@@ -170,5 +170,88 @@ fn a_halved_inflation_answers_as_one_set_over_the_halved_stretch() {
             }
         }
         assert!(differing > 5, "{model_name}: {differing} configurations with differing verdicts");
+    }
+}
+
+/// The passes over the obstacles alone and the self pairs alone ([`verdict_of`]) make the
+/// pass over all pairs: blocked when either is, clear when both are, tight otherwise; on
+/// random configurations and inflations in the MBM scenes, with both arm models, where each
+/// of the three verdicts occurs.
+#[test]
+fn the_obstacles_and_the_self_pairs_pass_make_the_whole() {
+    let spheres = sphere_panda();
+    let mut rng = rng(24);
+    for (model_name, robot) in [("spheres", spheres), ("capsules", load("panda"))] {
+        let (lower, upper) = (robot.lower(), robot.upper());
+        let mut seen = [0; 3];
+        for (s, scene_name) in SCENES.iter().enumerate() {
+            let problem = &problems(scene_name)[s];
+            let model = CollisionModel::new(&robot, &CollisionScene::new(&problem.obstacles));
+            let margin = if s % 2 == 0 { 0.0 } else { 0.01 };
+            for _ in 0..200 {
+                let q = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+                let towards = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+                let inflation =
+                    Inflation::along(&model, &(towards - q), rng.random_range(0.0..0.3));
+                let obstacles = verdict_of(&model, &q, margin, &inflation, Pairs::Obstacles);
+                let own = verdict_of(&model, &q, margin, &inflation, Pairs::SelfPairs);
+                let whole = verdict(&model, &q, margin, &inflation);
+                assert_eq!(whole, verdict_of(&model, &q, margin, &inflation, Pairs::All));
+                let expected = match (obstacles, own) {
+                    (Verdict::Blocked, _) | (_, Verdict::Blocked) => Verdict::Blocked,
+                    (Verdict::Clear, Verdict::Clear) => Verdict::Clear,
+                    _ => Verdict::Tight,
+                };
+                assert_eq!(whole, expected, "{model_name}/{scene_name}: {obstacles:?} {own:?}");
+                seen[whole as usize] += 1;
+            }
+        }
+        assert!(seen.iter().all(|&n| n > 0), "{model_name}: verdicts seen {seen:?}");
+    }
+}
+
+/// The self pairs' discrete edge check is sound over their own relative motion: on random
+/// edges, with no obstacles, an edge whose n + 1 evenly spaced points (n from
+/// `self_motion_bound` and a spacing) all keep the clearance with every self pair inflated by
+/// its relative motion over half their spacing keeps it at 1000 points along it by the
+/// independent `min_distance` (the self pairs alone in an empty scene); both outcomes occur.
+#[test]
+fn edges_the_self_pair_checks_call_clear_are_clear() {
+    let empty = CollisionScene::new(&[]);
+    let mut rng = rng(25);
+    for (model_name, robot) in [("spheres", sphere_panda()), ("capsules", load("panda"))] {
+        let (lower, upper) = (robot.lower(), robot.upper());
+        let model = CollisionModel::new(&robot, &empty);
+        let (mut proven, mut blocked) = (0, 0);
+        for trial in 0..2000 {
+            if proven >= 30 && blocked >= 5 {
+                break;
+            }
+            let margin = if trial % 2 == 0 { 0.0 } else { 0.01 };
+            let a = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+            let towards = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+            let dq = (towards - a) * rng.random_range(0.05..1.0);
+            let travel = self_motion_bound(&model, &dq);
+            assert!(travel <= motion_bound(&model, &dq), "{model_name}: {travel}");
+            let spacing = [0.1, 0.4, 1.0][rng.random_range(0..3)];
+            let n = (travel / spacing).ceil().max(1.0) as usize;
+            let inflation = Inflation::along(&model, &dq, 0.5 / n as Real);
+            let clear = (0..=n).all(|k| {
+                let q = a + dq * (k as Real / n as Real);
+                verdict_of(&model, &q, margin, &inflation, Pairs::SelfPairs) == Verdict::Clear
+            });
+            if !clear {
+                blocked += 1;
+                continue;
+            }
+            proven += 1;
+            for k in 0..=1000 {
+                let q = a + dq * (k as Real / 1000.0);
+                let (d, link, other) =
+                    min_distance(&robot, &arm_pose(&robot, &q), &empty).expect("self pairs");
+                assert!(d >= margin - 1e-9, "{model_name}: {link} {d} m from {other}");
+            }
+        }
+        assert!(proven >= 30 && blocked >= 5, "{model_name}: {proven} proven, {blocked} blocked");
     }
 }

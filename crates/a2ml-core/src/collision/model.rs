@@ -19,7 +19,7 @@ use crate::robot::{LinkRole, Robot};
 mod clear;
 mod pairs;
 
-pub use clear::{Inflation, Verdict, is_clear, verdict};
+pub use clear::{Inflation, Pairs, Verdict, is_clear, verdict, verdict_of};
 pub use pairs::{Closest, Pair};
 
 /// The arm's capsules and a scene's obstacles, prepared for [`clearance`] and
@@ -767,6 +767,17 @@ pub fn advancement_within(
 pub fn motion_bound(model: &CollisionModel, dq: &JointVector) -> Real {
     let dq = dq.abs();
     model.arm.links.iter().map(|l| l.levers.dot(&dq)).fold(0.0, Real::max)
+}
+
+/// The farthest a capsule of a self pair moves relative to the other along the straight
+/// joint-space motion `dq` (m), from any configuration: at most [`motion_bound`], and less
+/// where the pairs span few joints (0 with no self pairs).
+pub fn self_motion_bound(model: &CollisionModel, dq: &JointVector) -> Real {
+    let speed = dq.abs();
+    // A group pair's levers are its pairs' largest per joint, which may bound more than any
+    // one capsule moves; a pair's relative motion is its distal capsule's over some joints.
+    let pairs = model.arm.group_pairs.iter().map(|p| p.levers.dot(&speed)).fold(0.0, Real::max);
+    pairs.min(motion_bound(model, dq))
 }
 
 impl CollisionModel {

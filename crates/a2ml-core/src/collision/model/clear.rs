@@ -112,7 +112,7 @@ pub fn is_clear(
     clearance: Real,
     inflation: &Inflation,
 ) -> bool {
-    scan(model, q, clearance, inflation, false) == Verdict::Clear
+    scan(model, q, clearance, inflation, false, Pairs::All) == Verdict::Clear
 }
 
 /// What one pass over the pairs of a [`CollisionModel`] tells of a configuration
@@ -141,7 +141,31 @@ pub fn verdict(
     clearance: Real,
     inflation: &Inflation,
 ) -> Verdict {
-    scan(model, q, clearance, inflation, true)
+    scan(model, q, clearance, inflation, true, Pairs::All)
+}
+
+/// Which pairs of a [`CollisionModel`] a pass tests ([`verdict_of`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pairs {
+    /// Every pair: the arm's capsules against the obstacles, and the self pairs.
+    All,
+    /// The arm's capsules against the obstacles.
+    Obstacles,
+    /// The self pairs.
+    SelfPairs,
+}
+
+/// [`verdict`] over `pairs` alone: an edge check may cover the self pairs, which move
+/// relative to each other less than the arm moves among obstacles and are seldom near, with
+/// fewer checks than the obstacles need.
+pub fn verdict_of(
+    model: &CollisionModel,
+    q: &JointVector,
+    clearance: Real,
+    inflation: &Inflation,
+    pairs: Pairs,
+) -> Verdict {
+    scan(model, q, clearance, inflation, true, pairs)
 }
 
 /// The pass of [`verdict`]; with `settle` false it stops at the first pair within the inflated
@@ -152,6 +176,7 @@ fn scan(
     clearance: Real,
     inflation: &Inflation,
     settle: bool,
+    pairs: Pairs,
 ) -> Verdict {
     let arm = &*model.arm;
     let frames = arm.chain.frames(q);
@@ -173,7 +198,8 @@ fn scan(
             tight = true;
         }};
     }
-    for (g, group) in arm.groups.iter().enumerate() {
+    let groups = if pairs == Pairs::SelfPairs { &[][..] } else { &arm.groups[..] };
+    for (g, group) in groups.iter().enumerate() {
         let center = frames[group.frame].apply(&group.center);
         let near = limit + inflation.groups[g] * scale + group.bound;
         let mut posed: [Option<Posed>; GROUP_SIZE] = Default::default();
@@ -260,12 +286,13 @@ fn scan(
             }
         }
     }
+    let group_pairs = if pairs == Pairs::Obstacles { &[][..] } else { &arm.group_pairs[..] };
     let group_center = |g: usize| {
         arm.groups.get(g).map(|group| (frames[group.frame].apply(&group.center), group.bound))
     };
     // A capsule is in many self pairs: its bounding sphere's centre placed once.
     let mut centers = Centers::new();
-    for (gp, group_pair) in arm.group_pairs.iter().enumerate() {
+    for (gp, group_pair) in group_pairs.iter().enumerate() {
         let keep = limit + inflation.group_pairs[gp] * scale;
         // Sorted by floor within the group pair: the pairs from here on keep it at every
         // configuration.
