@@ -176,7 +176,8 @@ fn a_halved_inflation_answers_as_one_set_over_the_halved_stretch() {
 /// The passes over the obstacles alone and the self pairs alone ([`verdict_of`]) make the
 /// pass over all pairs: blocked when either is, clear when both are, tight otherwise; on
 /// random configurations and inflations in the MBM scenes, with both arm models, where each
-/// of the three verdicts occurs.
+/// of the three verdicts occurs. An inflation set for one part alone
+/// ([`Inflation::set_along_of`]) answers for it as the whole inflation does.
 #[test]
 fn the_obstacles_and_the_self_pairs_pass_make_the_whole() {
     let spheres = sphere_panda();
@@ -191,10 +192,27 @@ fn the_obstacles_and_the_self_pairs_pass_make_the_whole() {
             for _ in 0..200 {
                 let q = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
                 let towards = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
-                let inflation =
-                    Inflation::along(&model, &(towards - q), rng.random_range(0.0..0.3));
+                let (dq, units) = (towards - q, rng.random_range(0.0..0.3));
+                let inflation = Inflation::along(&model, &dq, units);
                 let obstacles = verdict_of(&model, &q, margin, &inflation, Pairs::Obstacles);
                 let own = verdict_of(&model, &q, margin, &inflation, Pairs::SelfPairs);
+                // An inflation set for some pairs answers for them as the whole one does, and
+                // for the others as if inflated without bound: never clear.
+                let none = Inflation::none(&model);
+                for (set, other) in
+                    [(Pairs::Obstacles, Pairs::SelfPairs), (Pairs::SelfPairs, Pairs::Obstacles)]
+                {
+                    let mut part = Inflation::none(&model);
+                    part.set_along_of(&model, &dq, units, set);
+                    let whole = verdict_of(&model, &q, margin, &inflation, set);
+                    assert_eq!(verdict_of(&model, &q, margin, &part, set), whole);
+                    let unbounded = match verdict_of(&model, &q, margin, &none, other) {
+                        Verdict::Clear => Verdict::Tight,
+                        plain => plain,
+                    };
+                    assert_eq!(verdict_of(&model, &q, margin, &part, other), unbounded);
+                    assert!(!is_clear(&model, &q, margin, &part));
+                }
                 let whole = verdict(&model, &q, margin, &inflation);
                 assert_eq!(whole, verdict_of(&model, &q, margin, &inflation, Pairs::All));
                 let expected = match (obstacles, own) {

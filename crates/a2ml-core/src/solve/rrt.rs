@@ -500,7 +500,7 @@ impl JointSpace<'_> {
         let n = (travel / spacing).ceil().max(1.0);
         let half = 0.5 / n;
         let n = n as usize;
-        self.inflation.set_along(&self.model, dq, half);
+        self.inflation.set_along_of(&self.model, dq, half, pairs);
         self.stretches.clear();
         self.stretches.push_back((0, n));
         self.halves.clear();

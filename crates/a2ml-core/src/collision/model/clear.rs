@@ -22,6 +22,9 @@ pub struct Inflation {
     /// What every value above is multiplied by when used: 2^−k after
     /// [`Inflation::set_halvings`], 1 otherwise.
     factor: Real,
+    /// The pairs the values are set for ([`Inflation::set_along_of`]); a pass over others
+    /// counts them as inflated without bound.
+    pairs: Pairs,
 }
 
 impl Inflation {
@@ -34,6 +37,7 @@ impl Inflation {
             suffixes: vec![[0.0; DOF]; arm.links.len()],
             group_pairs: vec![0.0; arm.group_pairs.len()],
             factor: 1.0,
+            pairs: Pairs::All,
         }
     }
 
@@ -48,11 +52,30 @@ impl Inflation {
 
     /// [`Inflation::along`] in place, for `model` (the one it was made for).
     pub fn set_along(&mut self, model: &CollisionModel, dq: &JointVector, s: Real) {
+        self.set_along_of(model, dq, s, Pairs::All);
+    }
+
+    /// [`Inflation::set_along`] for `pairs` alone, for a check of them alone
+    /// ([`verdict_of`]): half the work for either. A pass over pairs it is not set for
+    /// counts them as inflated without bound (never [`Verdict::Clear`]).
+    pub fn set_along_of(
+        &mut self,
+        model: &CollisionModel,
+        dq: &JointVector,
+        s: Real,
+        pairs: Pairs,
+    ) {
         let arm = &model.arm;
         self.factor = 1.0;
+        self.pairs = pairs;
         let speed = dq.abs() * s;
-        dots(&mut self.links, arm.links.iter().map(|l| &l.levers), &speed);
-        dots(&mut self.groups, arm.groups.iter().map(|g| &g.levers), &speed);
+        if pairs != Pairs::SelfPairs {
+            dots(&mut self.links, arm.links.iter().map(|l| &l.levers), &speed);
+            dots(&mut self.groups, arm.groups.iter().map(|g| &g.levers), &speed);
+        }
+        if pairs == Pairs::Obstacles {
+            return;
+        }
         dots(&mut self.group_pairs, arm.group_pairs.iter().map(|p| &p.levers), &speed);
         self.suffixes.resize(arm.links.len(), [0.0; DOF]);
         for (suffix, link) in self.suffixes.iter_mut().zip(&arm.links) {
@@ -155,6 +178,13 @@ pub enum Pairs {
     SelfPairs,
 }
 
+impl Pairs {
+    /// Whether these pairs include `other`.
+    fn covers(self, other: Pairs) -> bool {
+        self == Pairs::All || self == other
+    }
+}
+
 /// [`verdict`] over `pairs` alone: an edge check may cover the self pairs, which move
 /// relative to each other less than the arm moves among obstacles and are seldom near, with
 /// fewer checks than the obstacles need.
@@ -187,6 +217,12 @@ fn scan(
     // one.
     let mut scale: Real = inflation.factor;
     let mut tight = false;
+    if !inflation.pairs.covers(pairs) {
+        // Inflated without bound: the pass tells only whether the shapes themselves keep
+        // the clearance.
+        scale = 0.0;
+        tight = true;
+    }
     // A pair at `distance` (a lower bound) below `keep`, the inflated clearance, whose plain
     // clearance is `plain`: the pass ends (not settling, or a collision), or goes on uninflated.
     macro_rules! violated {
