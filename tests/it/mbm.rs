@@ -2,12 +2,14 @@
 //! a scene, and joint-space RRT paths among them re-checked densely and independently.
 
 use a2ml::collision::{
-    CollisionModel, CollisionScene, Inflation, Pairs, Verdict, clearance, is_clear, min_distance,
-    motion_bound, self_motion_bound, verdict, verdict_of,
+    CollisionModel, CollisionScene, DistanceOptions, Inflation, Pairs, Verdict, clearance,
+    coverage, distances, is_clear, min_distance, motion_bound, self_motion_bound, verdict,
+    verdict_of,
 };
 use a2ml::kinematics::arm_pose;
 use a2ml::language::Shape;
 use a2ml::math::{JointVector, Matrix3, Real};
+use a2ml::robot::Robot;
 use a2ml::solve::rrt::{RrtError, RrtOptions, rrt_connect};
 use rand::RngExt;
 
@@ -271,5 +273,82 @@ fn edges_the_self_pair_checks_call_clear_are_clear() {
             }
         }
         assert!(proven >= 30 && blocked >= 5, "{model_name}: {proven} proven, {blocked} blocked");
+    }
+}
+
+/// A check that keeps the clearance under a share c of an inflation along a motion over s
+/// units ([`coverage`]) covers c·s units either way: on random configurations and motions in
+/// the MBM scenes, with both arm models and two clearances, every pair keeps the clearance at
+/// 200 points of that stretch by the independent `min_distance`; `None` only where a pair is
+/// within it at the point itself, 1 exactly where the verdict is clear, and shares strictly
+/// between 0 and 1 occur (the partial covering is used, not only carried).
+#[test]
+fn the_share_of_an_inflation_a_check_keeps_covers_that_share_of_its_stretch() {
+    let mut rng = rng(26);
+    for (model_name, robot) in [("spheres", sphere_panda()), ("capsules", load("panda"))] {
+        let (lower, upper) = (robot.lower(), robot.upper());
+        let mut partial = 0;
+        for (s, scene_name) in SCENES.iter().enumerate() {
+            let problem = &problems(scene_name)[s];
+            let scene = CollisionScene::new(&problem.obstacles);
+            let model = CollisionModel::new(&robot, &scene);
+            let none = Inflation::none(&model);
+            for trial in 0..60 {
+                let margin = if trial % 2 == 0 { 0.0 } else { 0.01 };
+                let pairs = [Pairs::All, Pairs::Obstacles, Pairs::SelfPairs][trial % 3];
+                let q = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+                let towards = JointVector::from_fn(|i, _| rng.random_range(lower[i]..upper[i]));
+                let dq = towards - q;
+                let units = rng.random_range(0.01..0.4);
+                let mut inflation = Inflation::along(&model, &dq, units);
+                // Shares set on top of the inflation scale it as one set over fewer units.
+                let share = [1.0, 0.5, 0.3][trial % 3];
+                inflation.set_share(share);
+                let found = coverage(&model, &q, margin, &inflation, pairs);
+                let plain = verdict_of(&model, &q, margin, &none, pairs);
+                assert_eq!(found.is_none(), plain == Verdict::Blocked, "{model_name}/{scene_name}");
+                let Some(c) = found else { continue };
+                assert!((0.0..=1.0).contains(&c), "{model_name}/{scene_name}: share {c}");
+                let verdict = verdict_of(&model, &q, margin, &inflation, pairs);
+                assert_eq!(c == 1.0, verdict == Verdict::Clear, "{model_name}/{scene_name}");
+                partial += usize::from(c > 0.0 && c < 1.0);
+                let reach = c * share * units;
+                for k in 0..=200 {
+                    let p = q + dq * (reach * (2.0 * k as Real / 200.0 - 1.0));
+                    let d = independent_distance(&robot, &scene, &p, pairs);
+                    assert!(
+                        d >= margin - 1e-9,
+                        "{model_name}/{scene_name}: {pairs:?} {d} m at {p:?}"
+                    );
+                }
+            }
+        }
+        assert!(partial > 10, "{model_name}: {partial} partial shares");
+    }
+}
+
+/// The smallest distance of `pairs` with the arm at `q`, by [`min_distance`] and
+/// [`distances`] (the pairs closer than 5 cm whose other shape is not the robot's; ∞ for
+/// none).
+fn independent_distance(
+    robot: &Robot,
+    scene: &CollisionScene,
+    q: &JointVector,
+    pairs: Pairs,
+) -> Real {
+    let pose = arm_pose(robot, q);
+    let closest =
+        |scene: &CollisionScene| min_distance(robot, &pose, scene).map_or(Real::INFINITY, |c| c.0);
+    match pairs {
+        Pairs::All => closest(scene),
+        Pairs::SelfPairs => closest(&CollisionScene::new(&[])),
+        Pairs::Obstacles => {
+            let options = DistanceOptions { influence: 0.05 };
+            distances(robot, &pose, scene, &options)
+                .iter()
+                .filter(|p| p.obstacle_frame.is_none())
+                .map(|p| p.distance)
+                .fold(Real::INFINITY, Real::min)
+        }
     }
 }

@@ -28,7 +28,8 @@ mod model;
 pub use guard::{ShapeError, check_shapes};
 pub use model::{
     Closest, CollisionModel, Inflation, Pair, Pairs, Verdict, advancement, advancement_at_least,
-    advancement_within, clearance, is_clear, motion_bound, self_motion_bound, verdict, verdict_of,
+    advancement_within, clearance, coverage, is_clear, motion_bound, self_motion_bound, verdict,
+    verdict_of,
 };
 
 /// How much [`min_distance`] or [`clearance`] may differ from the exact

@@ -19,7 +19,7 @@ use crate::robot::{LinkRole, Robot};
 mod clear;
 mod pairs;
 
-pub use clear::{Inflation, Pairs, Verdict, is_clear, verdict, verdict_of};
+pub use clear::{Inflation, Pairs, Verdict, coverage, is_clear, verdict, verdict_of};
 pub use pairs::{Closest, Pair};
 
 /// The arm's capsules and a scene's obstacles, prepared for [`clearance`] and

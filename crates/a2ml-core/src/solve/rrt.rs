@@ -25,8 +25,8 @@ pub use super::timing::{LIMIT_FRACTION, TimedPath, shortest_bell, time_parameter
 pub use super::tree::DynamicDomain;
 use super::tree::{Growth, Tree, TreeSpace, connect_trees};
 use crate::collision::{
-    CollisionModel, CollisionScene, Inflation, Pairs, Verdict, advancement_within, clearance,
-    min_distance, motion_bound, self_motion_bound, verdict_of,
+    CollisionModel, CollisionScene, Inflation, Pairs, advancement_within, clearance, coverage,
+    min_distance, motion_bound, self_motion_bound,
 };
 use crate::kinematics::arm_pose;
 use crate::math::{JointVector, Real};
@@ -321,9 +321,10 @@ struct JointSpace<'a> {
     /// their stretch ([`Inflation::set_halvings`]; reused, to allocate once).
     inflation: Inflation,
     /// Stretches (first, last check point) of the discrete checks still to split, and the
-    /// halved checks (parameter, halvings) still to make (reused).
+    /// checks of what a check left uncovered (parameter, half-width, depth) still to make
+    /// (reused).
     stretches: VecDeque<(usize, usize)>,
-    halves: VecDeque<(Real, usize)>,
+    halves: VecDeque<(Real, Real, usize)>,
     checks: usize,
     /// When the search started, for its wall time.
     started: Instant,
@@ -474,16 +475,18 @@ impl JointSpace<'_> {
     /// clearance at t, the shapes themselves keep it over that stretch. The edge is first
     /// checked at n + 1 evenly spaced points, n = ⌈travel / spacing⌉, each covering 1/(2n)
     /// either way (no point of the arm moves farther than spacing/2 over it), which together
-    /// cover the edge. A point that keeps the clearance only uninflated has its stretch
-    /// covered by two checks of half of it, down to [`REFINEMENTS`] halvings; a point that does
-    /// not keep the clearance even uninflated is a configuration of the edge within it, and
-    /// the edge is blocked. So `Some(true)` only when the checks cover the whole edge.
+    /// cover the edge. A point whose shapes keep the clearance under only a share c of their
+    /// inflation ([`coverage`]) covers [t − ch, t + ch], and what is left either side is
+    /// checked at its middle with the inflation over its half-width, down to [`REFINEMENTS`]
+    /// levels; a point that does not keep the clearance even uninflated is a configuration of
+    /// the edge within it, and the edge is blocked. So `Some(true)` only when the checks cover
+    /// the whole edge.
     ///
     /// The points between are checked first, in bisection order (the middle first: on the
     /// MotionBenchMaker scenes a blocked edge is more often blocked there than at its new end;
     /// in the cage, of the blocked edges, 29 % were found at b and 50 % at the middle checked
     /// after it), then the new end b, then a (where the edge leaves the tree: clear itself, so
-    /// only what its check covers is in question), and the halvings last, so that a blocked
+    /// only what its check covers is in question), and the rests last, so that a blocked
     /// edge is found after few checks.
     fn discrete_edge(
         &mut self,
@@ -506,41 +509,43 @@ impl JointSpace<'_> {
         self.halves.clear();
         let (mut end_b, mut end_a) = (true, true);
         loop {
-            let (t, level) = if let Some((first, last)) = self.stretches.pop_front() {
+            let (t, h, level) = if let Some((first, last)) = self.stretches.pop_front() {
                 if last - first < 2 {
                     continue;
                 }
                 let middle = first + (last - first) / 2;
                 self.stretches.push_back((first, middle));
                 self.stretches.push_back((middle, last));
-                (middle as Real / n as Real, 0)
+                (middle as Real / n as Real, half, 0)
             } else if std::mem::take(&mut end_b) {
-                (1.0, 0)
+                (1.0, half, 0)
             } else if std::mem::take(&mut end_a) {
-                (0.0, 0)
-            } else if let Some(half) = self.halves.pop_front() {
-                half
+                (0.0, half, 0)
+            } else if let Some(rest) = self.halves.pop_front() {
+                rest
             } else {
                 return Some(true);
             };
-            self.inflation.set_halvings(level as i32);
+            self.inflation.set_share(h / half);
             let q = if t == 1.0 { *b } else { a + dq * t };
-            // One pass tells both whether the inflated shapes keep the clearance and, where
-            // not, whether the shapes themselves do.
+            // One pass tells both how much of [t − h, t + h] the shapes keep the clearance
+            // over and, where not all of it, whether they keep it at t.
             self.checks += 1;
-            match verdict_of(&self.model, &q, self.options.clearance, &self.inflation, pairs) {
-                Verdict::Clear => continue,
-                Verdict::Blocked => return Some(false),
-                Verdict::Tight => {}
-            }
+            let covered =
+                match coverage(&self.model, &q, self.options.clearance, &self.inflation, pairs) {
+                    None => return Some(false),
+                    Some(share) if share >= 1.0 => continue,
+                    Some(share) => share * h,
+                };
             if level == REFINEMENTS {
                 return None;
             }
-            // The two halves of [t − h, t + h]; at an end, the one outside the edge is not.
-            let h = half / (1 << level) as Real;
-            for t in [t - 0.5 * h, t + 0.5 * h] {
+            // What is left of [t − h, t + h] either side of [t − covered, t + covered], by
+            // the middle of each; at an end, the one outside the edge is not.
+            let rest = 0.5 * (h - covered);
+            for t in [t - covered - rest, t + covered + rest] {
                 if (0.0..=1.0).contains(&t) {
-                    self.halves.push_back((t, level + 1));
+                    self.halves.push_back((t, rest, level + 1));
                 }
             }
         }
@@ -552,8 +557,9 @@ impl JointSpace<'_> {
 /// checks in all than at the obstacles' spacing, or at four times it).
 const SELF_SPACING: Real = 2.0;
 
-/// How many times a discrete check's stretch is halved where its inflated shapes come within
-/// the clearance, before the edge is left to the covering checks.
+/// How many levels deep the rests of the discrete checks' stretches are checked where the
+/// inflated shapes come within the clearance, before the edge is left to the covering checks
+/// (on the MotionBenchMaker scenes, 3 levels cost more checks and 10 no fewer).
 const REFINEMENTS: usize = 6;
 
 /// A node of a joint-space tree: its configuration, and for a goal tree's root which goal it

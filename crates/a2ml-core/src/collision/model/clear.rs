@@ -97,6 +97,14 @@ impl Inflation {
     pub fn set_halvings(&mut self, halvings: i32) {
         self.factor = (0.5 as Real).powi(halvings);
     }
+
+    /// The inflation last set along `dq` over `s` units ([`Inflation::set_along`]) made that
+    /// of `share · s` units (`share` in [0, 1]): as [`Inflation::set_halvings`], exactly for a
+    /// power of two, and within a rounding of each product otherwise (far below the
+    /// clearance's own allowance for rounding).
+    pub fn set_share(&mut self, share: Real) {
+        self.factor = share;
+    }
 }
 
 /// `out[k] = levers[k] · speed`, written in place: an edge check sets an [`Inflation`] per
@@ -135,7 +143,7 @@ pub fn is_clear(
     clearance: Real,
     inflation: &Inflation,
 ) -> bool {
-    scan(model, q, clearance, inflation, false, Pairs::All) == Verdict::Clear
+    scan(model, q, clearance, inflation, false, Pairs::All) == Some(1.0)
 }
 
 /// What one pass over the pairs of a [`CollisionModel`] tells of a configuration
@@ -154,17 +162,16 @@ pub enum Verdict {
 /// `is_clear(model, q, clearance, inflation)`, else [`Verdict::Tight`] when
 /// `is_clear(model, q, clearance, &Inflation::none(model))`, else [`Verdict::Blocked`].
 ///
-/// The pass stops at the first pair within the clearance itself; the first pair within it
-/// only inflated makes the rest of the pass test the shapes uninflated (the pairs before it
-/// kept the inflated clearance, so they keep the plain one). What a sampling planner's edge
-/// check asks at a point: covered, or a collision found, or neither yet.
+/// The pass stops at the first pair within the clearance itself ([`coverage`] over every
+/// pair). What a sampling planner's edge check asks at a point: covered, or a collision
+/// found, or neither yet.
 pub fn verdict(
     model: &CollisionModel,
     q: &JointVector,
     clearance: Real,
     inflation: &Inflation,
 ) -> Verdict {
-    scan(model, q, clearance, inflation, true, Pairs::All)
+    verdict_of(model, q, clearance, inflation, Pairs::All)
 }
 
 /// Which pairs of a [`CollisionModel`] a pass tests ([`verdict_of`]).
@@ -195,11 +202,35 @@ pub fn verdict_of(
     inflation: &Inflation,
     pairs: Pairs,
 ) -> Verdict {
+    match coverage(model, q, clearance, inflation, pairs) {
+        None => Verdict::Blocked,
+        Some(share) if share >= 1.0 => Verdict::Clear,
+        Some(_) => Verdict::Tight,
+    }
+}
+
+/// How much of `inflation` the shapes of `pairs` keep the clearance under, with the arm at
+/// `q`: `None` when a pair is within the clearance itself, else a share c in [0, 1] such that
+/// every pair keeps it with each shape inflated by c times its inflation (1: all of it, as
+/// [`Verdict::Clear`]). An inflation along a motion over s units scales with s, so a check
+/// that keeps a share c of it covers c·s units either way: where an edge check's stretch is
+/// not covered whole, it is covered in part.
+///
+/// One pass: a pair within the inflated clearance lowers the share to what it keeps, and the
+/// rest of the pass tests the shapes inflated by that share. The share is found from lower
+/// bounds of the distances, so it is never more than the pairs keep (and may be less).
+pub fn coverage(
+    model: &CollisionModel,
+    q: &JointVector,
+    clearance: Real,
+    inflation: &Inflation,
+    pairs: Pairs,
+) -> Option<Real> {
     scan(model, q, clearance, inflation, true, pairs)
 }
 
-/// The pass of [`verdict`]; with `settle` false it stops at the first pair within the inflated
-/// clearance, answering [`Verdict::Blocked`] (not clear, without telling which way).
+/// The pass of [`coverage`]; with `settle` false it stops at the first pair within the inflated
+/// clearance, answering `None` (not clear, without telling which way).
 fn scan(
     model: &CollisionModel,
     q: &JointVector,
@@ -207,31 +238,34 @@ fn scan(
     inflation: &Inflation,
     settle: bool,
     pairs: Pairs,
-) -> Verdict {
+) -> Option<Real> {
     let arm = &*model.arm;
     let frames = arm.chain.frames(q);
     // Distances are compared with this raised by a shape's inflation (and its radius).
     let limit = clearance + ROUNDING;
-    // The inflation's factor while the shapes are inflated; 0 once a pair came within the
-    // inflated clearance (`tight`) and the rest of the pass looks for a pair within the plain
-    // one.
-    let mut scale: Real = inflation.factor;
-    let mut tight = false;
+    // The share of the inflation every pair tested so far keeps the clearance under, and the
+    // factor the shapes are inflated by for the rest of the pass (the inflation's, times it):
+    // a pair that keeps that keeps the clearance over the share of the stretch.
+    let mut covered: Real = 1.0;
     if !inflation.pairs.covers(pairs) {
         // Inflated without bound: the pass tells only whether the shapes themselves keep
         // the clearance.
-        scale = 0.0;
-        tight = true;
+        covered = 0.0;
     }
-    // A pair at `distance` (a lower bound) below `keep`, the inflated clearance, whose plain
-    // clearance is `plain`: the pass ends (not settling, or a collision), or goes on uninflated.
+    let mut scale: Real = inflation.factor * covered;
+    // A pair at `distance` (a lower bound) below `inflated`, its clearance with the shapes
+    // inflated by `scale`, whose plain clearance is `plain`: the pass ends (not settling, or a
+    // collision), or goes on with the share the pair keeps. The clearances differ by the
+    // pair's inflation times `scale`, so the share is the distance's part of the difference;
+    // its rounding is far below the ROUNDING every clearance carries.
     macro_rules! violated {
-        ($distance:expr, $plain:expr) => {{
-            if !settle || $distance < $plain {
-                return Verdict::Blocked;
+        ($distance:expr, $plain:expr, $inflated:expr) => {{
+            let (distance, plain) = ($distance, $plain);
+            if !settle || distance < plain {
+                return None;
             }
-            scale = 0.0;
-            tight = true;
+            covered *= (distance - plain) / ($inflated - plain);
+            scale = inflation.factor * covered;
         }};
     }
     let groups = if pairs == Pairs::SelfPairs { &[][..] } else { &arm.groups[..] };
@@ -256,8 +290,7 @@ fn scan(
                 let link = slot.get_or_insert_with(|| place(m));
                 let squared = link.squared_distance_to_point(&sphere.center);
                 if squared < reach * reach {
-                    let plain = keep(m, 0.0) + sphere.radius;
-                    violated!(squared, plain * plain);
+                    violated!(squared.sqrt(), keep(m, 0.0) + sphere.radius, reach);
                 }
             }
         }
@@ -271,14 +304,16 @@ fn scan(
             for (m, slot) in posed.iter_mut().enumerate().take(group.members.len()) {
                 let link = slot.get_or_insert_with(|| place(m));
                 let distance = segment_segment_distance(&link.a, &link.b, &capsule.a, &capsule.b);
-                if distance < keep(m, scale) + capsule.radius {
-                    violated!(distance, keep(m, 0.0) + capsule.radius);
+                let inflated = keep(m, scale) + capsule.radius;
+                if distance < inflated {
+                    violated!(distance, keep(m, 0.0) + capsule.radius, inflated);
                 }
             }
         }
         for convex in &model.convex {
             let body = &convex.body;
-            if (center - body.center).norm() - body.bound >= near
+            let reach = near + body.bound;
+            if (center - body.center).norm_squared() >= reach * reach
                 || convex.local_point_distance_below(&convex.local(&center), near).is_none()
             {
                 continue;
@@ -293,7 +328,7 @@ fn scan(
                         in_axes.get_or_insert_with(|| convex.frame_in_axes(&frames[group.frame]));
                     let local = frame.apply(&capsule.a);
                     if let Some(distance) = convex.local_point_distance_below(&local, inflated) {
-                        violated!(distance, keep(m, 0.0));
+                        violated!(distance, keep(m, 0.0), inflated);
                     }
                     continue;
                 }
@@ -303,7 +338,7 @@ fn scan(
                 if link.inverse_squared_length == 0.0 {
                     let distance = convex.point_distance(&link.a);
                     if distance < inflated {
-                        violated!(distance, keep(m, 0.0));
+                        violated!(distance, keep(m, 0.0), inflated);
                     }
                     continue;
                 }
@@ -317,7 +352,7 @@ fn scan(
                     None
                 };
                 if let Some(distance) = close {
-                    violated!(distance, keep(m, 0.0));
+                    violated!(distance, keep(m, 0.0), inflated);
                 }
             }
         }
@@ -381,9 +416,9 @@ fn scan(
                 link.posed(&frames).distance(&other.posed(&frames))
             };
             if distance < keep {
-                violated!(distance, limit);
+                violated!(distance, limit, keep);
             }
         }
     }
-    if tight { Verdict::Tight } else { Verdict::Clear }
+    Some(covered)
 }
