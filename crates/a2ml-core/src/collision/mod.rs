@@ -5,7 +5,8 @@
 //! [`min_distance`]; for many configurations of one scene (sampling
 //! planners), [`CollisionModel`] with [`clearance`], [`advancement`] (and
 //! [`advancement_at_least`]) and [`motion_bound`], [`is_clear`] for a yes-or-no check with
-//! shapes inflated by an [`Inflation`] ([`verdict`]: with and without it in one pass);
+//! shapes inflated by an [`Inflation`] ([`verdict`]: with and without it in one pass;
+//! [`coverage`]: the share of it kept; [`verdict_of`]: the obstacles' or the self pairs' alone);
 //! [`check_shapes`] before any query, so
 //! that no pair is skipped for a shape parry cannot handle. Everything is in {b}, SI
 //! units. parry enters the crate here only; its glam types never leave this

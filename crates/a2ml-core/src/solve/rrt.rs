@@ -317,14 +317,14 @@ struct JointSpace<'a> {
     model: CollisionModel,
     /// Uncovered stretches of the edge being checked (reused, to allocate once).
     gaps: Vec<Gap>,
-    /// The shapes' inflation for the discrete checks of the edge being checked, halved with
-    /// their stretch ([`Inflation::set_halvings`]; reused, to allocate once).
+    /// The shapes' inflation for the discrete checks of the edge being checked, scaled to
+    /// each check's stretch ([`Inflation::set_share`]; reused, to allocate once).
     inflation: Inflation,
     /// Stretches (first, last check point) of the discrete checks still to split, and the
     /// checks of what a check left uncovered (parameter, half-width, depth) still to make
     /// (reused).
     stretches: VecDeque<(usize, usize)>,
-    halves: VecDeque<(Real, Real, usize)>,
+    rests: VecDeque<(Real, Real, usize)>,
     checks: usize,
     /// When the search started, for its wall time.
     started: Instant,
@@ -357,7 +357,7 @@ impl<'a> JointSpace<'a> {
             model,
             gaps: Vec::new(),
             stretches: VecDeque::new(),
-            halves: VecDeque::new(),
+            rests: VecDeque::new(),
             checks: 0,
             started,
         }
@@ -506,7 +506,7 @@ impl JointSpace<'_> {
         self.inflation.set_along_of(&self.model, dq, half, pairs);
         self.stretches.clear();
         self.stretches.push_back((0, n));
-        self.halves.clear();
+        self.rests.clear();
         let (mut end_b, mut end_a) = (true, true);
         loop {
             let (t, h, level) = if let Some((first, last)) = self.stretches.pop_front() {
@@ -521,7 +521,7 @@ impl JointSpace<'_> {
                 (1.0, half, 0)
             } else if std::mem::take(&mut end_a) {
                 (0.0, half, 0)
-            } else if let Some(rest) = self.halves.pop_front() {
+            } else if let Some(rest) = self.rests.pop_front() {
                 rest
             } else {
                 return Some(true);
@@ -545,7 +545,7 @@ impl JointSpace<'_> {
             let rest = 0.5 * (h - covered);
             for t in [t - covered - rest, t + covered + rest] {
                 if (0.0..=1.0).contains(&t) {
-                    self.halves.push_back((t, rest, level + 1));
+                    self.rests.push_back((t, rest, level + 1));
                 }
             }
         }
