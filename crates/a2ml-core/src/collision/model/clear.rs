@@ -20,7 +20,8 @@ pub struct Inflation {
     suffixes: Vec<[Real; DOF]>,
     group_pairs: Vec<Real>,
     /// What every value above is multiplied by when used: 2^−k after
-    /// [`Inflation::set_halvings`], 1 otherwise.
+    /// [`Inflation::set_halvings`], the share after [`Inflation::set_share`], 1 once set
+    /// along a motion.
     factor: Real,
     /// The pairs the values are set for ([`Inflation::set_along_of`]); a pass over others
     /// counts them as inflated without bound.
