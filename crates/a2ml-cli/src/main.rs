@@ -4,6 +4,10 @@
 //! the signal's number when interrupted, see [`signals`]).
 //! Everything else lives in [`commands`] and the core library.
 
+// The arguments' doc comments are clap's help text, where `<FILE>` is a placeholder the
+// user reads, not an HTML tag.
+#![allow(rustdoc::invalid_html_tags)]
+
 mod args;
 mod batch;
 mod commands;

@@ -18,7 +18,7 @@ pub trait Spelled: Serialize + DeserializeOwned + Copy + PartialEq + 'static {
 ///
 /// # Panics
 /// Never for a [`Spelled`] enum: serde writes each of its values as a unit variant, which
-/// [`VariantName`] reads; anything else is a bug in the enum's derive, caught by the
+/// `VariantName` reads; anything else is a bug in the enum's derive, caught by the
 /// spelling tests of every enum.
 pub fn spelling<T: Spelled>(value: T) -> &'static str {
     match value.serialize(VariantName) {

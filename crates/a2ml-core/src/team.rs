@@ -9,7 +9,7 @@
 //! already inside, each at most one piece from its end. A helper keeps watching for the next
 //! batch for [`LINGER`] after its last one, as OpenMP runtimes and BLAS pools do between
 //! parallel regions, so a loop of batched calls finds it awake; then it dozes, then sleeps
-//! (see [`watch`]).
+//! (see `watch`).
 //!
 //! The work is one closure that every thread runs at once; it shares itself out (each thread
 //! takes the next piece from a common queue) and returns when no piece is left. Which thread
@@ -148,7 +148,7 @@ impl Team {
     /// the wake-up crosses the hypervisor), and the helper comes some 40 µs later. `long`
     /// says the work takes far longer than that (hundreds of microseconds): sleeping helpers
     /// are then woken before the caller starts. Otherwise they are woken after its run, for
-    /// the calls that follow; a helper that only dozes (see [`watch`]) is never woken, it
+    /// the calls that follow; a helper that only dozes (see `watch`) is never woken, it
     /// looks for work on its own.
     pub fn run(&self, work: &(dyn Fn() + Sync), long: bool) {
         let shared = &*self.shared;

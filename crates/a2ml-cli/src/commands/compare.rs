@@ -1,4 +1,4 @@
-//! `a2ml compare`: plans one task with several solvers ([`solve::compare`]) and prints one
+//! `a2ml compare`: plans one task with several solvers ([`a2ml_core::solve::compare`]) and prints one
 //! table, a row per solver and segment: goal errors, path kept, the worst joint-limit margin
 //! and its joint, the smallest clearance and its link, the peak joint speed against the
 //! limits, the duration and the planning time. `--json` prints the records instead; `-o DIR`

@@ -1,5 +1,5 @@
 //! `a2ml map`: the time × swivel obstacle map of one segment of a task
-//! ([`solve::map::segment_map`]) drawn as an SVG figure, with the profile the
+//! ([`a2ml_core::solve::map::segment_map`]) drawn as an SVG figure, with the profile the
 //! `map` solver would choose. Stdout gets a short summary; a segment without
 //! a profile is a warning, since the figure shows why.
 

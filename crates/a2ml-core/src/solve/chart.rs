@@ -151,7 +151,7 @@ impl Chart {
     }
 
     /// The chart distance between two points: σ scaled by the path's length, positions by
-    /// [`Chart::position_scale`], rotations as geodesic angles, angles (swivel wrapped).
+    /// the chart's position scale, rotations as geodesic angles, angles (swivel wrapped).
     pub fn distance(&self, a: &ChartPoint, b: &ChartPoint) -> Real {
         let sigma = (a.sigma - b.sigma) * self.path_scale;
         let free: Real = (0..3)

@@ -23,7 +23,7 @@
 //! the collision model's conservative advancement ([`crate::collision::advancement`]) must
 //! show that the chord keeps the clearance plus twice the IK curve's deviation from it at the
 //! step's middle (the deviation were the curve quadratic), or the step is halved. A step whose
-//! joints jump by more than [`MAX_JUMP`], or move faster than [`MAX_GAIN`] per unit of chart
+//! joints jump by more than `MAX_JUMP`, or move faster than `MAX_GAIN` per unit of chart
 //! length (a singularity or another IK branch), ends the edge. Where two IK solutions of one
 //! chart point differ by a self-motion at a singularity (the wrist's first and last axes
 //! aligned), the path turns the joints between them, which does not move the state. The

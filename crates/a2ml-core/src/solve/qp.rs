@@ -5,7 +5,7 @@
 //! before the position limits and one velocity-damper row per arm-obstacle pair inside the
 //! influence distance. J is square, so the unconstrained minimiser almost always tracks V
 //! exactly; when it already satisfies every bound and row it is the QP's solution. When some
-//! bind, the dual active-set method of Goldfarb and Idnani ([`dual`]) on the same Cholesky
+//! bind, the dual active-set method of Goldfarb and Idnani (`qp::dual`) on the same Cholesky
 //! factor solves the step exactly in finitely many steps; Clarabel only confirms or solves the
 //! steps it reports infeasible or degenerate (counted in [`QpStats::clarabel_steps`]).
 //! Clarabel is used here only.

@@ -131,13 +131,13 @@ impl Inflation {
     }
 }
 
-/// Whether, with the arm at `q`, every pair of [`super::min_distance`] is at least `clearance`
+/// Whether, with the arm at `q`, every pair of [`crate::collision::min_distance`] is at least `clearance`
 /// (m) apart once each shape is inflated by `inflation`: an arm capsule against an obstacle by
 /// the capsule's, a self pair by the pair's. Stops at the first pair that is not.
 ///
 /// Every test is a lower bound of the pair's distance (bounding spheres, closed forms, the
 /// tangent bound of a segment against a box or cylinder), so a `true` is never wrong; a `false`
-/// may come from a pair within [`super::SEGMENT_TOLERANCE`] of the bound.
+/// may come from a pair within `SEGMENT_TOLERANCE` (1e-11 m) of the bound.
 pub fn is_clear(
     model: &CollisionModel,
     q: &JointVector,

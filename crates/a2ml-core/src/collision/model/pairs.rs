@@ -62,7 +62,7 @@ impl CollisionModel {
 
     /// Calls `f(pair, signed distance)` for every pair at `q`: each moving capsule against each
     /// obstacle (capsule by capsule, obstacles in the scene's order), then the self pairs in the
-    /// robot's order. A distance is within [`super::SEGMENT_TOLERANCE`] below the exact one
+    /// robot's order. A distance is within `SEGMENT_TOLERANCE` (1e-11 m) below the exact one
     /// (exact for spheres and capsules); a penetration's depth is parry's for boxes and
     /// cylinders, as in [`super::clearance`].
     pub fn measure_pairs(&self, q: &JointVector, mut f: impl FnMut(Pair, Real)) {

@@ -108,8 +108,8 @@ impl RotationReference {
 
     /// The angle (rad, in (-π, π]) along the path of the path's rotation nearest to `r` (the
     /// smallest geodesic angle); 0 for a hold. With M = R R0ᵀ and a the axis,
-    /// tr(Rot(a, s)ᵀ M) = aᵀMa + (tr M − aᵀMa) cos s − tr([a]× M) sin s, largest at
-    /// s = atan2(−tr([a]× M), tr M − aᵀMa).
+    /// tr(Rot(a, s)ᵀ M) = aᵀMa + (tr M − aᵀMa) cos s − tr(\[a\]× M) sin s, largest at
+    /// s = atan2(−tr(\[a\]× M), tr M − aᵀMa).
     pub fn nearest_distance(&self, r: &Rotation3) -> Real {
         match self.path {
             RotationPath::Hold => 0.0,
