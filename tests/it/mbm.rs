@@ -118,20 +118,17 @@ fn edges_the_inflated_checks_call_clear_are_clear() {
                     continue;
                 }
                 proven += 1;
-                for k in 0..=1000 {
-                    let q = a + dq * (k as Real / 1000.0);
-                    let (d, link, o) =
-                        min_distance(&robot, &arm_pose(&robot, &q), &scene).expect("pairs");
-                    assert!(d >= margin - 1e-9, "{model_name}/{scene_name}: {link} {d} m from {o}");
-                }
+                let points = (0..=1000).map(|k| a + dq * (k as Real / 1000.0));
+                let label = format!("{model_name}/{scene_name}");
+                assert_points_keep(&robot, &scene, points, margin, Pairs::All, &label);
             }
             assert!(proven > 0 && blocked > 0, "{model_name}/{scene_name}: {proven} {blocked}");
         }
     }
 }
 
-/// An inflation halved k times in place ([`Inflation::set_halvings`]) answers as one set along
-/// the motion over 2^-k of the units, verdict for verdict, in both arm models, where the
+/// An inflation halved k times in place ([`Inflation::set_share`] of 2^-k) answers as one set
+/// along the motion over 2^-k of the units, verdict for verdict, in both arm models, where the
 /// verdicts of the halvings differ (so the factor is used, not only carried).
 #[test]
 fn a_halved_inflation_answers_as_one_set_over_the_halved_stretch() {
@@ -153,7 +150,7 @@ fn a_halved_inflation_answers_as_one_set_over_the_halved_stretch() {
                 let mut halved = Inflation::along(&model, &dq, units);
                 let mut seen = Vec::new();
                 for k in 0..8 {
-                    halved.set_halvings(k);
+                    halved.set_share((0.5 as Real).powi(k));
                     let fresh = Inflation::along(&model, &dq, units / (1 << k) as Real);
                     let found = verdict(&model, &q, margin, &halved);
                     assert_eq!(
@@ -265,12 +262,8 @@ fn edges_the_self_pair_checks_call_clear_are_clear() {
                 continue;
             }
             proven += 1;
-            for k in 0..=1000 {
-                let q = a + dq * (k as Real / 1000.0);
-                let (d, link, other) =
-                    min_distance(&robot, &arm_pose(&robot, &q), &empty).expect("self pairs");
-                assert!(d >= margin - 1e-9, "{model_name}: {link} {d} m from {other}");
-            }
+            let points = (0..=1000).map(|k| a + dq * (k as Real / 1000.0));
+            assert_points_keep(&robot, &empty, points, margin, Pairs::SelfPairs, model_name);
         }
         assert!(proven >= 30 && blocked >= 5, "{model_name}: {proven} proven, {blocked} blocked");
     }
@@ -313,42 +306,46 @@ fn the_share_of_an_inflation_a_check_keeps_covers_that_share_of_its_stretch() {
                 assert_eq!(c == 1.0, verdict == Verdict::Clear, "{model_name}/{scene_name}");
                 partial += usize::from(c > 0.0 && c < 1.0);
                 let reach = c * share * units;
-                for k in 0..=200 {
-                    let p = q + dq * (reach * (2.0 * k as Real / 200.0 - 1.0));
-                    let d = independent_distance(&robot, &scene, &p, pairs);
-                    assert!(
-                        d >= margin - 1e-9,
-                        "{model_name}/{scene_name}: {pairs:?} {d} m at {p:?}"
-                    );
-                }
+                let points = (0..=200).map(|k| q + dq * (reach * (2.0 * k as Real / 200.0 - 1.0)));
+                let label = format!("{model_name}/{scene_name}");
+                assert_points_keep(&robot, &scene, points, margin, pairs, &label);
             }
         }
         assert!(partial > 10, "{model_name}: {partial} partial shares");
     }
 }
 
-/// The smallest distance of `pairs` with the arm at `q`, by [`min_distance`] and
-/// [`distances`] (the pairs closer than 5 cm whose other shape is not the robot's; ∞ for
-/// none).
-fn independent_distance(
+/// Asserts that `pairs` keep `margin` (less 1e-9 m) at every one of `points`, by the
+/// independent distances: [`min_distance`] for all pairs and the self pairs (those alone in an
+/// empty scene; there must be some), [`distances`] for the obstacles (the pairs closer than
+/// 5 cm whose other shape is not the robot's; none closer passes).
+fn assert_points_keep(
     robot: &Robot,
     scene: &CollisionScene,
-    q: &JointVector,
+    points: impl Iterator<Item = JointVector>,
+    margin: Real,
     pairs: Pairs,
-) -> Real {
-    let pose = arm_pose(robot, q);
-    let closest =
-        |scene: &CollisionScene| min_distance(robot, &pose, scene).map_or(Real::INFINITY, |c| c.0);
-    match pairs {
-        Pairs::All => closest(scene),
-        Pairs::SelfPairs => closest(&CollisionScene::new(&[])),
-        Pairs::Obstacles => {
-            let options = DistanceOptions { influence: 0.05 };
-            distances(robot, &pose, scene, &options)
-                .iter()
-                .filter(|p| p.obstacle_frame.is_none())
-                .map(|p| p.distance)
-                .fold(Real::INFINITY, Real::min)
+    label: &str,
+) {
+    let empty = CollisionScene::new(&[]);
+    for q in points {
+        let pose = arm_pose(robot, &q);
+        let closest = match pairs {
+            Pairs::All | Pairs::SelfPairs => {
+                let scene = if pairs == Pairs::All { scene } else { &empty };
+                Some(min_distance(robot, &pose, scene).expect("the robot has pairs"))
+            }
+            Pairs::Obstacles => {
+                let options = DistanceOptions { influence: 0.05 };
+                distances(robot, &pose, scene, &options)
+                    .into_iter()
+                    .filter(|p| p.obstacle_frame.is_none())
+                    .min_by(|a, b| a.distance.total_cmp(&b.distance))
+                    .map(|p| (p.distance, p.link, p.obstacle))
+            }
+        };
+        if let Some((d, link, other)) = closest {
+            assert!(d >= margin - 1e-9, "{label}: {pairs:?}: {link} {d} m from {other} at {q:?}");
         }
     }
 }

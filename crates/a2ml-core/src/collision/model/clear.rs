@@ -19,9 +19,8 @@ pub struct Inflation {
     /// the joints between the two frames, and a capsule's are zero past its frame).
     suffixes: Vec<[Real; DOF]>,
     group_pairs: Vec<Real>,
-    /// What every value above is multiplied by when used: 2^−k after
-    /// [`Inflation::set_halvings`], the share after [`Inflation::set_share`], 1 once set
-    /// along a motion.
+    /// What every value above is multiplied by when used: the share after
+    /// [`Inflation::set_share`], 1 once set along a motion.
     factor: Real,
     /// The pairs the values are set for ([`Inflation::set_along_of`]); a pass over others
     /// counts them as inflated without bound.
@@ -90,19 +89,12 @@ impl Inflation {
 }
 
 impl Inflation {
-    /// The inflation last set along `dq` over `s` units ([`Inflation::set_along`]) made that of
-    /// `s / 2^halvings` units, for the price of one number: a power of two scales every product
-    /// and sum of it exactly, so [`is_clear`] and [`verdict`] answer bit for bit as after
-    /// `set_along(model, dq, s / 2^halvings)`. The edge checks halve a stretch's inflation
-    /// several times.
-    pub fn set_halvings(&mut self, halvings: i32) {
-        self.factor = (0.5 as Real).powi(halvings);
-    }
-
     /// The inflation last set along `dq` over `s` units ([`Inflation::set_along`]) made that
-    /// of `share · s` units (`share` in [0, 1]): as [`Inflation::set_halvings`], exactly for a
-    /// power of two, and within a rounding of each product otherwise (far below the
-    /// clearance's own allowance for rounding).
+    /// of `share · s` units (`share` in [0, 1]), for the price of one number: a power of two
+    /// scales every product and sum of it exactly, so [`coverage`] answers bit for bit as
+    /// after `set_along(model, dq, share · s)`; another share is within a rounding of each
+    /// product (far below the clearance's own allowance for rounding). The edge checks scale
+    /// an edge's inflation to each check's stretch.
     pub fn set_share(&mut self, share: Real) {
         self.factor = share;
     }
@@ -247,12 +239,9 @@ fn scan(
     // The share of the inflation every pair tested so far keeps the clearance under, and the
     // factor the shapes are inflated by for the rest of the pass (the inflation's, times it):
     // a pair that keeps that keeps the clearance over the share of the stretch.
-    let mut covered: Real = 1.0;
-    if !inflation.pairs.covers(pairs) {
-        // Inflated without bound: the pass tells only whether the shapes themselves keep
-        // the clearance.
-        covered = 0.0;
-    }
+    // Pairs the inflation is not set for are inflated without bound: the pass then tells only
+    // whether the shapes themselves keep the clearance.
+    let mut covered: Real = if inflation.pairs.covers(pairs) { 1.0 } else { 0.0 };
     let mut scale: Real = inflation.factor * covered;
     // A pair at `distance` (a lower bound) below `inflated`, its clearance with the shapes
     // inflated by `scale`, whose plain clearance is `plain`: the pass ends (not settling, or a
