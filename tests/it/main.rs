@@ -10,6 +10,7 @@ mod errors;
 mod foxglove_layout;
 mod hamp;
 mod hostile;
+mod judge;
 mod ik;
 mod jacobians;
 mod language;

@@ -10,6 +10,10 @@
 //! by [`OptOptions::limit_margin`]. A one-dimensional search over θsw first
 //! samples the closed-form feasible swivel intervals.
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use rayon::prelude::*;
+
 use crate::collision::{CollisionModel, CollisionScene, min_distance};
 use crate::kinematics::{
     CpsaState, HatState, KinematicsError, arm_pose, cpsa_state, cpsa_to_hat, hat_state,
@@ -597,21 +601,43 @@ impl Search<'_> {
 
     /// The local optimum from each start, best first, stopping at the first that meets the
     /// tolerance.
+    ///
+    /// Each start is searched on its own, from no measured clearance, so that the starts are
+    /// searched side by side on the thread pool; a start after one that met the tolerance is
+    /// left out (or its search is thrown away), and the results are read in order, so that
+    /// the optima and the count of evaluations are those of searching one start after the
+    /// other.
     fn multistart(
         &mut self,
         starts: &[Vec<Real>],
     ) -> Vec<(Vec<Real>, ArmState, JointVector, Real)> {
-        let mut found = Vec::new();
-        for x0 in starts {
-            if let Some(local) = self.minimise(x0.clone()) {
-                let done = local.3 < self.options.tolerance;
-                found.push(local);
-                if done {
-                    break;
+        // The first start known to meet the tolerance.
+        let first_met = AtomicUsize::new(usize::MAX);
+        let searched: Vec<_> = (starts.par_iter().enumerate())
+            .map(|(i, x0)| {
+                if i > first_met.load(Ordering::Relaxed) {
+                    return None;
                 }
+                let mut search = Search { measured: None, evaluations: 0, ..self.clone() };
+                let local = search.minimise(x0.clone());
+                if local.as_ref().is_some_and(|l| l.3 < self.options.tolerance) {
+                    first_met.fetch_min(i, Ordering::Relaxed);
+                }
+                Some((local, search.evaluations))
+            })
+            .collect();
+        let mut found = Vec::new();
+        // Every start up to the first that met the tolerance was searched.
+        for (local, evaluations) in searched.into_iter().map_while(|s| s) {
+            self.evaluations += evaluations;
+            let Some(local) = local else { continue };
+            let met = local.3 < self.options.tolerance;
+            found.push(local);
+            if met {
+                break;
             }
         }
-        // Stable: among equal residuals the earlier start wins, as before.
+        // Stable: among equal residuals the earlier start wins.
         found.sort_by(|a, b| a.3.total_cmp(&b.3));
         found
     }

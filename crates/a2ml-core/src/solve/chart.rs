@@ -195,29 +195,9 @@ impl Chart {
     /// of its tolerance. This is the distance from the path's locus, whatever the timing: a
     /// solver that lags behind its reference but stays on the line has not left it.
     pub fn deviation(&self, state: &ArmState, tolerance: &Tolerance) -> [Real; 3] {
-        // A path component whose reference does not move (a hold) is at the same value at
-        // every σ (σ scales a zero distance), so its error is measured once, not at every σ
-        // tried; goal components are 0.
-        let error_of = |k: usize, target: Target| -> Real {
-            goal_error(state, &[(self.variables[k], target)])
-        };
-        let error_at = |k: usize, sigma: Real| error_of(k, self.references[k].at_fraction(sigma));
-        let fixed: [Option<Real>; 3] = std::array::from_fn(|k| {
-            if !self.on_path[k] {
-                Some(0.0)
-            } else if self.references[k].bell().distance() == 0.0 {
-                Some(error_at(k, 0.0))
-            } else {
-                None
-            }
-        });
-        let errors = |sigma: Real| -> [Real; 3] {
-            std::array::from_fn(|k| fixed[k].unwrap_or_else(|| error_at(k, sigma)))
-        };
-        let worst_of = |e: &[Real; 3]| -> Real {
-            (0..3).map(|k| e[k] / tolerance.of(self.variables[k])).fold(0.0, Real::max)
-        };
-        let worst = |sigma: Real| -> Real { worst_of(&errors(sigma)) };
+        let fixed = self.fixed_errors(state);
+        let errors = |sigma: Real| self.errors_at(state, &fixed, sigma);
+        let worst = |sigma: Real| self.worst_of(&errors(sigma), tolerance);
         if self.sigma_max <= 0.0 {
             return errors(0.0);
         }
@@ -230,7 +210,7 @@ impl Chart {
                     continue;
                 }
                 let e = errors(sigma);
-                let w = worst_of(&e);
+                let w = self.worst_of(&e, tolerance);
                 if best.is_none_or(|(_, b)| w.total_cmp(&b).is_lt()) {
                     best = Some((e, w));
                 }
@@ -239,8 +219,7 @@ impl Chart {
         };
         // One moving path component (the usual case): the σ nearest in closed form; the other
         // path components are holds, the same at every σ.
-        let mut moving =
-            (0..3).filter(|&k| self.on_path[k] && self.references[k].bell().distance() > 0.0);
+        let mut moving = self.moving();
         if let (Some(k), None) = (moving.next(), moving.next()) {
             let value = state.value(self.variables[k]);
             if let Some(sigma) = self.references[k].nearest_fraction(&value) {
@@ -264,9 +243,10 @@ impl Chart {
         let best = (self.scan.iter().enumerate())
             .map(|(i, targets)| {
                 let sigma = i as Real * h;
-                let e =
-                    std::array::from_fn(|k| fixed[k].unwrap_or_else(|| error_of(k, targets[k])));
-                (sigma, worst_of(&e))
+                let e = std::array::from_fn(|k| {
+                    fixed[k].unwrap_or_else(|| self.error_of(state, k, targets[k]))
+                });
+                (sigma, self.worst_of(&e, tolerance))
             })
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map_or(0.0, |(sigma, _)| sigma);
@@ -285,7 +265,118 @@ impl Chart {
                 wb = worst(b);
             }
         }
-        best_of(&[best, 0.5 * (lo + hi)])
+        // Each moving component's own nearest σ too (tried last, so only where it is better):
+        // what [`Chart::deviation_bound`] measures, so that it bounds this.
+        // (A component that does not move repeats `best`, which is measured once.)
+        let own = self.own_nearest(state).map(|s| s.map_or(best, |s| s.clamp(0.0, self.sigma_max)));
+        best_of(&[best, 0.5 * (lo + hi), own[0], own[1], own[2]])
+    }
+
+    /// The largest of each component's [`Chart::deviation`] over `states`: what judging a
+    /// motion's path asks. Where the deviation searches (two or more moving path components),
+    /// a cheap bound of each state's largest normalised error ([`Chart::deviation_bound`])
+    /// orders the states, largest first, and leaves out those whose bound cannot raise any
+    /// component's largest so far: the same result as measuring every state.
+    pub fn largest_deviation<'s>(
+        &self,
+        states: impl IntoIterator<Item = &'s ArmState>,
+        tolerance: &Tolerance,
+    ) -> [Real; 3] {
+        let raise = |worst: &mut [Real; 3], e: [Real; 3]| {
+            for (w, e) in worst.iter_mut().zip(e) {
+                *w = Real::max(*w, e);
+            }
+        };
+        let mut worst = [0.0; 3];
+        let mut bounded = Vec::new();
+        for state in states {
+            match self.deviation_bound(state, tolerance) {
+                Some(bound) => bounded.push((bound, state)),
+                None => raise(&mut worst, self.deviation(state, tolerance)),
+            }
+        }
+        // Largest bound first, ties in the motion's order (a stable sort).
+        bounded.sort_by(|a, b| b.0.total_cmp(&a.0));
+        for (bound, state) in bounded {
+            // e_k ≤ tol_k · W ≤ tol_k · bound, with room for the rounding of e_k / tol_k.
+            let bound = bound * (1.0 + 1e-12);
+            let settled = (0..3)
+                .all(|k| !self.on_path[k] || tolerance.of(self.variables[k]) * bound <= worst[k]);
+            if !settled {
+                raise(&mut worst, self.deviation(state, tolerance));
+            }
+        }
+        worst
+    }
+
+    /// An upper bound of the largest normalised error (error over tolerance) of
+    /// [`Chart::deviation`] at `state`, where the deviation searches σ: the least of the
+    /// largest errors at each moving component's own nearest σ, which the search always tries.
+    /// `None` where the deviation is itself a closed form (at most one moving component).
+    pub fn deviation_bound(&self, state: &ArmState, tolerance: &Tolerance) -> Option<Real> {
+        if self.sigma_max <= 0.0 || self.moving().nth(1).is_none() {
+            return None;
+        }
+        let fixed = self.fixed_errors(state);
+        self.own_nearest(state)
+            .into_iter()
+            .flatten()
+            .map(|s| {
+                self.worst_of(
+                    &self.errors_at(state, &fixed, s.clamp(0.0, self.sigma_max)),
+                    tolerance,
+                )
+            })
+            .min_by(Real::total_cmp)
+    }
+
+    /// The path components whose reference moves.
+    fn moving(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..3).filter(|&k| self.on_path[k] && self.references[k].bell().distance() > 0.0)
+    }
+
+    /// Each moving path component's nearest σ in closed form (unclamped), `None` for the
+    /// others.
+    fn own_nearest(&self, state: &ArmState) -> [Option<Real>; 3] {
+        std::array::from_fn(|k| {
+            let moves = self.on_path[k] && self.references[k].bell().distance() > 0.0;
+            moves
+                .then(|| self.references[k].nearest_fraction(&state.value(self.variables[k])))
+                .flatten()
+        })
+    }
+
+    /// Component `k`'s error at `state` against `target`.
+    fn error_of(&self, state: &ArmState, k: usize, target: Target) -> Real {
+        goal_error(state, &[(self.variables[k], target)])
+    }
+
+    /// The errors that do not depend on σ: 0 for goal components, and a path component whose
+    /// reference does not move (a hold) is at the same value at every σ (σ scales a zero
+    /// distance), so it is measured once, not at every σ tried. `None` for the moving ones.
+    fn fixed_errors(&self, state: &ArmState) -> [Option<Real>; 3] {
+        std::array::from_fn(|k| {
+            if !self.on_path[k] {
+                Some(0.0)
+            } else if self.references[k].bell().distance() == 0.0 {
+                Some(self.error_of(state, k, self.references[k].at_fraction(0.0)))
+            } else {
+                None
+            }
+        })
+    }
+
+    /// Every component's error at `sigma`, the fixed ones as given.
+    fn errors_at(&self, state: &ArmState, fixed: &[Option<Real>; 3], sigma: Real) -> [Real; 3] {
+        std::array::from_fn(|k| {
+            fixed[k]
+                .unwrap_or_else(|| self.error_of(state, k, self.references[k].at_fraction(sigma)))
+        })
+    }
+
+    /// The largest of the errors in units of their tolerances.
+    fn worst_of(&self, errors: &[Real; 3], tolerance: &Tolerance) -> Real {
+        (0..3).map(|k| errors[k] / tolerance.of(self.variables[k])).fold(0.0, Real::max)
     }
 
     /// The IK solutions of `x` within the joint limits, the one nearest to `near` first.

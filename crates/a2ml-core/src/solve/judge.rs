@@ -80,8 +80,8 @@ pub fn path_errors(
     path_errors_of(problem, chart, hard, &sample_states(robot, trajectory), tolerance)
 }
 
-/// [`path_errors`] over the samples' states ([`sample_states`]): infinite errors from a
-/// singular sample on.
+/// [`path_errors`] over the samples' states ([`sample_states`]): infinite errors where a
+/// sample is singular.
 pub fn path_errors_of(
     problem: &SegmentProblem,
     chart: &Chart,
@@ -89,15 +89,10 @@ pub fn path_errors_of(
     states: &[Option<ArmState>],
     tolerance: &Tolerance,
 ) -> ([Real; 3], bool) {
-    let mut worst = [0.0; 3];
-    for state in states {
-        let Some(state) = state else {
-            return ([Real::INFINITY; 3], !hard);
-        };
-        for (w, e) in worst.iter_mut().zip(chart.deviation(state, tolerance)) {
-            *w = Real::max(*w, e);
-        }
+    if states.iter().any(Option::is_none) {
+        return ([Real::INFINITY; 3], !hard);
     }
+    let worst = chart.largest_deviation(states.iter().flatten(), tolerance);
     (worst, reached(tolerance, &problem.components, &worst) || !hard)
 }
 

@@ -8,6 +8,10 @@
 //! Hermite curve, slowing the segments it still finds too fast. What cannot be repaired (a
 //! position limit) is a warning naming the segment, whose report is then not ok.
 
+use std::sync::Mutex;
+use std::sync::mpsc::{Sender, channel};
+
+use rayon::prelude::*;
 use std::time::Instant;
 
 use super::assembly::Assembly;
@@ -294,6 +298,11 @@ pub fn plan_with_progress(
     };
     let close_starts = checks::before_solving(robot, &task_b, &decomposition, &bounds)?;
     let total = decomposition.actions.iter().map(|a| a.segments.len()).sum();
+    // Each action's obstacles (its `contact` ones left out), kept for the reports written
+    // while later segments are solved.
+    let scenes: Vec<CollisionScene> = (decomposition.actions.iter())
+        .map(|a| CollisionScene::new(&task_b.action_scene(a.index)))
+        .collect();
     let mut state = Solver {
         robot,
         task: &task_b,
@@ -308,12 +317,41 @@ pub fn plan_with_progress(
         deadline,
         rate,
         q: decomposition.start,
+        solved: 0,
         pieces: Vec::with_capacity(total),
         notes: Vec::new(),
     };
-    for action in &decomposition.actions {
-        state.action(action, total, progress)?;
-    }
+    // Solving is sequential (each segment starts where the last ended); judging and
+    // reporting a solved segment is not: a thread of its own reports the segments as they are
+    // solved, and once the last is solved this thread reports beside it. (A thread, not the
+    // pool: it waits for the segments, and a pool's worker must not wait.) Each report lands
+    // in its segment's slot, whichever thread wrote it.
+    let reporter = state.reporter();
+    let (sender, receiver) = channel::<(usize, Job, Solved)>();
+    let queue = Mutex::new(receiver);
+    let slots: Mutex<Vec<Option<Piece>>> = Mutex::new((0..total).map(|_| None).collect());
+    let report_all = || {
+        loop {
+            // The lock is held while waiting, not while reporting.
+            let next = queue.lock().unwrap_or_else(|e| e.into_inner()).recv();
+            let Ok((slot, job, solution)) = next else { break };
+            let piece = reporter.piece(job, solution);
+            slots.lock().unwrap_or_else(|e| e.into_inner())[slot] = Some(piece);
+        }
+    };
+    let solved = std::thread::scope(|scope| {
+        let writer = scope.spawn(report_all);
+        let solved = (decomposition.actions.iter().zip(&scenes))
+            .try_for_each(|(action, scene)| state.action(action, scene, total, progress, &sender));
+        // The queue closes once every segment sent is taken, whether or not all were solved.
+        drop(sender);
+        report_all();
+        writer.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        solved
+    });
+    solved?;
+    state.pieces =
+        slots.into_inner().unwrap_or_else(|e| e.into_inner()).into_iter().flatten().collect();
     let (whole, mut notes) = if state.pieces.is_empty() {
         // No action: the arm stays at the start.
         let still = vec![JointVector::zeros()];
@@ -334,8 +372,21 @@ pub fn plan_with_progress(
         .iter()
         .map(|p| Placed { start: p.start, stretch: p.stretch, problem: &p.problem })
         .collect();
-    let references = reference_samples(robot, &placed, whole.times());
-    let reference_ends = reference_ends(robot, &placed);
+    // Each segment's start and action, for the obstacles an action touches on purpose.
+    let spans: Vec<(Real, usize)> =
+        state.pieces.iter().map(|p| (p.report.start, p.report.action_index)).collect();
+    // The references and the output's distances, side by side on the thread pool.
+    let ((references, reference_ends), distances) = rayon::join(
+        || (reference_samples(robot, &placed, whole.times()), reference_ends(robot, &placed)),
+        || {
+            capsule_distances(&whole, robot, &task_b.scene, |sample, obstacle| {
+                let t = whole.times()[sample];
+                spans.iter().rev().find(|(start, _)| *start <= t).is_some_and(|(_, action)| {
+                    task.actions[*action].contact.iter().any(|c| c == obstacle)
+                })
+            })
+        },
+    );
     let mut segments = Vec::with_capacity(state.pieces.len());
     let mut wrist_reference = Vec::new();
     let mut swivel_maps = Vec::new();
@@ -346,12 +397,6 @@ pub fn plan_with_progress(
         }
         segments.push(piece.report);
     }
-    let distances = capsule_distances(&whole, robot, &task_b.scene, |sample, obstacle| {
-        let t = whole.times()[sample];
-        segments.iter().rev().find(|s| s.start <= t).is_some_and(|s: &SegmentReport| {
-            task.actions[s.action_index].contact.iter().any(|c| c == obstacle)
-        })
-    });
     let safety = options.safety_distance;
     warnings.extend(segments.iter().filter_map(|s| checks::too_close(s, safety)));
     warnings.extend(segments.iter().filter(|s| !s.reached).map(missed));
@@ -422,6 +467,9 @@ struct Solver<'a> {
     rate: Real,
     /// Where the arm really is: the end of what has been solved.
     q: JointVector,
+    /// Segments solved so far.
+    solved: usize,
+    /// The solved segments with their reports, in order, once every report is written.
     pieces: Vec<Piece>,
     /// Warnings other than missed goals: fallbacks and stretched durations.
     notes: Vec<Warning>,
@@ -457,16 +505,17 @@ impl Job<'_> {
     }
 }
 
-impl Solver<'_> {
+impl<'a> Solver<'a> {
     /// Solves the action's segments one after the other, each from where the last ended,
-    /// reporting progress.
-    fn action(
+    /// reporting progress, and sends each to `reports` as it is solved.
+    fn action<'s>(
         &mut self,
-        action: &PlannedAction,
+        action: &'s PlannedAction,
+        scene: &'s CollisionScene,
         total: usize,
         progress: &mut dyn FnMut(&Progress),
+        reports: &Sender<(usize, Job<'s>, Solved)>,
     ) -> Result<(), SolveError> {
-        let scene = CollisionScene::new(&self.task.action_scene(action.index));
         let hard = matches!(
             &self.task.actions[action.index].body,
             ActionBody::Constraints { path: Some(path), .. } if path.hard
@@ -480,16 +529,8 @@ impl Solver<'_> {
                 .primitives
                 .iter()
                 .any(|p| matches!(p.constraint, PrimitiveConstraint::Path(_)));
-            let job = Job {
-                action,
-                k,
-                segment,
-                problem,
-                scene: &scene,
-                chart,
-                hard: hard && carries_path,
-            };
-            let done = self.pieces.len();
+            let job = Job { action, k, segment, problem, scene, chart, hard: hard && carries_path };
+            let done = self.solved;
             let name = action.name.clone();
             // Never backwards, when `auto` goes on from one solver to another.
             let mut most: Real = 0.0;
@@ -503,19 +544,10 @@ impl Solver<'_> {
             if let Some(end) = solution.trajectory.positions().last() {
                 self.q = *end;
             }
-            let reference = self.reference(&job.problem);
-            let report = self.report(&job, &solution);
-            self.pieces.push(Piece {
-                action: action.index,
-                trajectory: solution.trajectory,
-                report,
-                reference,
-                problem: job.problem,
-                stretch: 1.0,
-                start: 0.0,
-                swivel_map: solution.swivel_map,
-            });
-            let done = self.pieces.len();
+            // The writer is gone only when it panicked, which its join passes on.
+            let _ = reports.send((self.solved, job, solution));
+            self.solved += 1;
+            let done = self.solved;
             progress(&Progress {
                 done,
                 total,
@@ -533,30 +565,32 @@ impl Solver<'_> {
     /// the rounds run out). Completes the reports with the measures of the output. Returns
     /// the output and the notes on what was repaired.
     fn finish(&mut self) -> Result<(Trajectory, Vec<Warning>), SolveError> {
-        for piece in &mut self.pieces {
+        // A copy: joining below borrows the solver.
+        let limits = &self.limits.clone();
+        self.pieces.par_iter_mut().for_each(|piece| {
             let t = &piece.trajectory;
-            let stretch = peaks(t, t.start(), t.end()).stretch(&self.limits);
+            let stretch = peaks(t, t.start(), t.end()).stretch(limits);
             if stretch > 1.0 + LIMIT_TOLERANCE {
                 piece.stretch = stretch * (1.0 + 1e-6);
             }
-        }
+        });
         let mut round = 0;
         let (output, blend_notes) = loop {
             let (whole, notes) = self.join_all()?;
             let output = whole.resample(self.rate)?;
             round += 1;
-            let mut again = false;
-            for piece in &mut self.pieces {
+            let again = self.pieces.par_iter_mut().map(|piece| {
                 let end = piece.start + piece.trajectory.duration() * piece.stretch;
-                let stretch = peaks(&output, piece.start, end).stretch(&self.limits);
-                if stretch > 1.0 + LIMIT_TOLERANCE && round < OUTPUT_ROUNDS {
+                let stretch = peaks(&output, piece.start, end).stretch(limits);
+                let slowed = stretch > 1.0 + LIMIT_TOLERANCE && round < OUTPUT_ROUNDS;
+                if slowed {
                     // A little more than asked: the output's samples fall elsewhere on the
                     // slower motion, and its curve between them with them.
                     piece.stretch *= stretch * 1.02;
-                    again = true;
                 }
-            }
-            if !again {
+                slowed
+            });
+            if !again.reduce(|| false, |a, b| a || b) {
                 break (output, notes);
             }
         };
@@ -581,8 +615,9 @@ impl Solver<'_> {
                     message,
                 ));
             }
-            complete(piece, &output, self.robot, &self.limits);
         }
+        let robot = self.robot;
+        self.pieces.par_iter_mut().for_each(|piece| complete(piece, &output, robot, limits));
         Ok((output, notes))
     }
 
@@ -699,8 +734,9 @@ impl Solver<'_> {
                 }
             }
             SolverChoice::Auto if pattern == SegmentPattern::Mixed => {
-                let qp = self.qp(job, monitor)?;
-                let why = match (qp.reached, qp.path_kept, qp.stalled) {
+                let mut qp = self.qp(job, monitor)?;
+                let path_kept = qp.judge_path(self.robot, job, &self.options.tolerance).kept;
+                let why = match (qp.reached, path_kept, qp.stalled) {
                     (true, true, _) => return Ok(qp),
                     (_, false, _) => Fallback::QpLeftPath,
                     (_, _, true) => Fallback::QpStalled,
@@ -708,7 +744,7 @@ impl Solver<'_> {
                 };
                 if map_fits(job) {
                     match self.map(job) {
-                        Ok(map) if map.reached && map.path_kept => {
+                        Ok(map) if map.reached && map.path_kept() => {
                             return Ok(Solved { fallback: Some(why), ..map });
                         }
                         Ok(_) | Err(SolveError::Map { .. }) => {}
@@ -716,7 +752,7 @@ impl Solver<'_> {
                     }
                 }
                 match self.constrained(job, monitor) {
-                    Ok(rrt) if rrt.reached && rrt.path_kept => {
+                    Ok(rrt) if rrt.reached && rrt.path_kept() => {
                         Ok(Solved { fallback: Some(why), ..rrt })
                     }
                     Ok(_) => {
@@ -772,21 +808,12 @@ impl Solver<'_> {
             segment: job.k,
             source,
         })?;
-        let states = judge::sample_states(self.robot, &solution.trajectory);
-        let (path_errors, path_kept) = judge::path_errors_of(
-            &job.problem,
-            &job.chart,
-            job.hard,
-            &states,
-            &self.options.tolerance,
-        );
+        // The path is judged when `auto` decides by it, else by the report.
         Ok(Solved {
             solver: SolverChoice::Qp,
-            states,
             trajectory: solution.trajectory,
             errors: solution.errors,
-            path_errors,
-            path_kept,
+            path: None,
             settle: solution.settle,
             reached: solution.reached,
             stalled: solution.stalled,
@@ -940,11 +967,9 @@ impl Solver<'_> {
         );
         Solved {
             solver,
-            states,
             trajectory,
             errors,
-            path_errors,
-            path_kept,
+            path: Some(PathJudgement { states, errors: path_errors, kept: path_kept }),
             settle,
             reached,
             stalled,
@@ -952,6 +977,41 @@ impl Solver<'_> {
             rrt,
             fallback: None,
             swivel_map: None,
+        }
+    }
+
+    /// What the reports of the segments solved read of the plan.
+    fn reporter(&self) -> Reporter<'a> {
+        Reporter { robot: self.robot, tolerance: self.options.tolerance, rate: self.rate }
+    }
+}
+
+/// What a segment's report reads besides the segment: the robot, the tolerance and the
+/// output rate, shared by the reports written on the thread pool.
+#[derive(Clone, Copy)]
+struct Reporter<'a> {
+    robot: &'a Robot,
+    tolerance: Tolerance,
+    rate: Real,
+}
+
+impl Reporter<'_> {
+    /// The solved segment judged (where that waited for the report), reported, and ready to
+    /// be joined.
+    fn piece(&self, job: Job, mut solution: Solved) -> Piece {
+        let path = (solution.path.take())
+            .unwrap_or_else(|| judge_path(self.robot, &job, &self.tolerance, &solution.trajectory));
+        let reference = self.reference(&job.problem);
+        let report = self.report(&job, &solution, &path);
+        Piece {
+            action: job.action.index,
+            trajectory: solution.trajectory,
+            report,
+            reference,
+            problem: job.problem,
+            stretch: 1.0,
+            start: 0.0,
+            swivel_map: solution.swivel_map,
         }
     }
 
@@ -965,8 +1025,8 @@ impl Solver<'_> {
 
     /// The segment's report as solved, in its own time; [`complete`] adds what joining
     /// decides and the measures of the output.
-    fn report(&self, job: &Job, solution: &Solved) -> SegmentReport {
-        let tolerance = &self.options.tolerance;
+    fn report(&self, job: &Job, solution: &Solved, path: &PathJudgement) -> SegmentReport {
+        let tolerance = &self.tolerance;
         let error = |variable: Variable, error: Real| VariableError {
             variable,
             error,
@@ -975,7 +1035,7 @@ impl Solver<'_> {
         let components = job.problem.components.iter();
         let errors = components.clone().zip(solution.errors).map(|(c, e)| error(c.variable, e));
         let path_errors = components
-            .zip(solution.path_errors)
+            .zip(path.errors)
             .filter(|(c, _)| c.role == Role::Path)
             .map(|(c, e)| error(c.variable, e))
             .collect();
@@ -996,7 +1056,7 @@ impl Solver<'_> {
             errors: errors.collect(),
             path_errors,
             hard_path: job.hard,
-            path_kept: solution.path_kept,
+            path_kept: path.kept,
             clearance: trajectory::min_clearance(&solution.trajectory, self.robot, job.scene),
             limit_margin: limit_margin(self.robot, &solution.trajectory),
             stalled: solution.stalled,
@@ -1013,7 +1073,7 @@ impl Solver<'_> {
             speed_peaks: featured_peaks(
                 &segment_focus(job),
                 solution.trajectory.times(),
-                &solution.states,
+                &path.states,
             ),
         }
     }
@@ -1147,14 +1207,10 @@ struct Solved {
     solver: SolverChoice,
     /// From time 0.
     trajectory: Trajectory,
-    /// The arm's state at each sample of the trajectory (`None` where singular), which the
-    /// judgement and the report read.
-    states: Vec<Option<ArmState>>,
     errors: [Real; 3],
-    /// Largest distance of each component from its path (0 for goals).
-    path_errors: [Real; 3],
-    /// The path kept within tolerance, or not hard.
-    path_kept: bool,
+    /// How far the motion kept the segment's path: judged at once where `auto` decides by it,
+    /// else by the report (`None` until then).
+    path: Option<PathJudgement>,
     settle: Real,
     reached: bool,
     stalled: bool,
@@ -1164,6 +1220,41 @@ struct Solved {
     fallback: Option<Fallback>,
     /// The map and profile, when the swivel map solved it.
     swivel_map: Option<MapSummary>,
+}
+
+impl Solved {
+    /// The path judgement, measured now if it waited.
+    fn judge_path(&mut self, robot: &Robot, job: &Job, tolerance: &Tolerance) -> &PathJudgement {
+        self.path.get_or_insert_with(|| judge_path(robot, job, tolerance, &self.trajectory))
+    }
+
+    /// Whether the path was kept; false where it has not been judged.
+    fn path_kept(&self) -> bool {
+        self.path.as_ref().is_some_and(|p| p.kept)
+    }
+}
+
+/// The states of `trajectory`'s samples and how far it kept `job`'s path.
+fn judge_path(
+    robot: &Robot,
+    job: &Job,
+    tolerance: &Tolerance,
+    trajectory: &Trajectory,
+) -> PathJudgement {
+    let states = judge::sample_states(robot, trajectory);
+    let (errors, kept) =
+        judge::path_errors_of(&job.problem, &job.chart, job.hard, &states, tolerance);
+    PathJudgement { states, errors, kept }
+}
+
+/// The arm's state at each sample of a solved segment (`None` where singular), which the
+/// judgement and the report read, and how far the motion kept the segment's path.
+struct PathJudgement {
+    states: Vec<Option<ArmState>>,
+    /// Largest distance of each component from its path (0 for goals).
+    errors: [Real; 3],
+    /// The path kept within tolerance, or not hard.
+    kept: bool,
 }
 
 /// The trajectory with `offset` added to its times.
