@@ -6,7 +6,7 @@ use a2ml::Robot;
 use a2ml::decompose::ArmState;
 use a2ml::language::{self, Target, Variable};
 use a2ml::math::{Real, Vector3};
-use a2ml::profile::{PositionReference, Reference, RotationReference, Role};
+use a2ml::profile::{PositionReference, Reference, Role, RotationReference};
 use a2ml::solve::chart::Chart;
 use a2ml::solve::problem::{Component, SegmentProblem};
 use a2ml::solve::{PlanOptions, Tolerance, plan};
@@ -58,10 +58,10 @@ fn the_largest_deviation_is_that_of_every_state_measured() {
             .filter_map(|q| ArmState::at(&robot, &q).ok())
             .collect();
         for tolerance in &tolerances {
-            let every = states.iter().map(|s| chart.deviation(s, tolerance)).fold(
-                [0.0; 3],
-                |worst: [Real; 3], e| std::array::from_fn(|k| worst[k].max(e[k])),
-            );
+            let every = states
+                .iter()
+                .map(|s| chart.deviation(s, tolerance))
+                .fold([0.0; 3], |worst: [Real; 3], e| std::array::from_fn(|k| worst[k].max(e[k])));
             let largest = chart.largest_deviation(&states, tolerance);
             assert_eq!(largest.map(Real::to_bits), every.map(Real::to_bits), "case {case}");
             for state in &states {
@@ -71,9 +71,8 @@ fn the_largest_deviation_is_that_of_every_state_measured() {
                     .map(|k| e[k] / tolerance.of(problem.components[k].variable))
                     .fold(0.0, Real::max);
                 assert!(worst <= bound, "case {case}: {worst} above its bound {bound}");
-                let raises = (0..3).any(|k| {
-                    tolerance.of(problem.components[k].variable) * bound > every[k]
-                });
+                let raises =
+                    (0..3).any(|k| tolerance.of(problem.components[k].variable) * bound > every[k]);
                 left_out += usize::from(!raises);
             }
         }

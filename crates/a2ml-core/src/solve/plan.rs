@@ -323,42 +323,46 @@ pub fn plan_with_progress(
     };
     // Solving is sequential (each segment starts where the last ended); judging and
     // reporting a solved segment is not: a thread of its own reports the segments as they are
-    // solved, and once the last is solved this thread reports beside it. (A thread, not the
-    // pool: it waits for the segments, and a pool's worker must not wait.) Each report lands
-    // in its segment's slot, whichever thread wrote it.
+    // solved, and once the last is solved this thread joins them into the output and then
+    // reports beside it. (A thread, not the pool: it waits for the segments, and a pool's
+    // worker must not wait.) Each report lands in its segment's slot, whichever thread wrote
+    // it.
     let reporter = state.reporter();
     let (sender, receiver) = channel::<(usize, Job, Solved)>();
     let queue = Mutex::new(receiver);
-    let slots: Mutex<Vec<Option<Piece>>> = Mutex::new((0..total).map(|_| None).collect());
+    let slots: Mutex<Vec<Option<Reported>>> = Mutex::new((0..total).map(|_| None).collect());
     let report_all = || {
         loop {
             // The lock is held while waiting, not while reporting.
             let next = queue.lock().unwrap_or_else(|e| e.into_inner()).recv();
             let Ok((slot, job, solution)) = next else { break };
-            let piece = reporter.piece(job, solution);
-            slots.lock().unwrap_or_else(|e| e.into_inner())[slot] = Some(piece);
+            let reported = reporter.report(job, solution);
+            slots.lock().unwrap_or_else(|e| e.into_inner())[slot] = Some(reported);
         }
     };
-    let solved = std::thread::scope(|scope| {
+    let joined = std::thread::scope(|scope| {
         let writer = scope.spawn(report_all);
         let solved = (decomposition.actions.iter().zip(&scenes))
             .try_for_each(|(action, scene)| state.action(action, scene, total, progress, &sender));
         // The queue closes once every segment sent is taken, whether or not all were solved.
         drop(sender);
+        let joined = solved.and_then(|()| {
+            if state.pieces.is_empty() {
+                // No action: the arm stays at the start.
+                let still = vec![JointVector::zeros()];
+                Ok((Trajectory::new(vec![0.0], vec![decomposition.start], still)?, Vec::new()))
+            } else {
+                state.join_keeping_limits()
+            }
+        });
         report_all();
         writer.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        solved
+        joined
     });
-    solved?;
-    state.pieces =
+    let (whole, mut notes) = joined?;
+    let mut reported: Vec<Reported> =
         slots.into_inner().unwrap_or_else(|e| e.into_inner()).into_iter().flatten().collect();
-    let (whole, mut notes) = if state.pieces.is_empty() {
-        // No action: the arm stays at the start.
-        let still = vec![JointVector::zeros()];
-        (Trajectory::new(vec![0.0], vec![decomposition.start], still)?, Vec::new())
-    } else {
-        state.finish()?
-    };
+    state.complete(&mut reported, &whole);
     let mut warnings = close_starts;
     warnings.extend(state.notes);
     warnings.append(&mut notes);
@@ -373,8 +377,7 @@ pub fn plan_with_progress(
         .map(|p| Placed { start: p.start, stretch: p.stretch, problem: &p.problem })
         .collect();
     // Each segment's start and action, for the obstacles an action touches on purpose.
-    let spans: Vec<(Real, usize)> =
-        state.pieces.iter().map(|p| (p.report.start, p.report.action_index)).collect();
+    let spans: Vec<(Real, usize)> = state.pieces.iter().map(|p| (p.start, p.action)).collect();
     // The references and the output's distances, side by side on the thread pool.
     let ((references, reference_ends), distances) = rayon::join(
         || (reference_samples(robot, &placed, whole.times()), reference_ends(robot, &placed)),
@@ -390,12 +393,12 @@ pub fn plan_with_progress(
     let mut segments = Vec::with_capacity(state.pieces.len());
     let mut wrist_reference = Vec::new();
     let mut swivel_maps = Vec::new();
-    for piece in state.pieces {
-        wrist_reference.extend(piece.reference.iter().map(|(t, p)| (piece.start + t, *p)));
+    for (piece, reported) in state.pieces.into_iter().zip(reported) {
+        wrist_reference.extend(reported.reference.iter().map(|(t, p)| (piece.start + t, *p)));
         if let Some(map) = piece.swivel_map {
             swivel_maps.push(SegmentSwivelMap { segment: segments.len(), map });
         }
-        segments.push(piece.report);
+        segments.push(reported.report);
     }
     let safety = options.safety_distance;
     warnings.extend(segments.iter().filter_map(|s| checks::too_close(s, safety)));
@@ -424,15 +427,15 @@ const OUTPUT_ROUNDS: usize = 8;
 /// Relative tolerance of the limit checks: rounding, not motion.
 const LIMIT_TOLERANCE: Real = 1e-9;
 
-/// One solved segment waiting to be joined: its motion from time 0 (at the solver's rate), its
-/// report, and what joining decides.
+/// One solved segment waiting to be joined: its motion from time 0 (at the solver's rate) and
+/// what joining decides.
 struct Piece {
-    /// The action's index in the decomposition.
+    /// The action's index in the task.
     action: usize,
+    /// The action's name and the segment's index in it.
+    name: String,
+    segment: usize,
     trajectory: Trajectory,
-    report: SegmentReport,
-    /// The reference wrist path, in the segment's own time.
-    reference: Vec<(Real, Vector3)>,
     /// The segment's references, for [`Plan::references`].
     problem: SegmentProblem,
     /// The factor the segment is slowed down by (1: as solved).
@@ -453,6 +456,13 @@ impl Piece {
     }
 }
 
+/// A solved segment's report, in its own time until [`Solver::complete`], and its reference
+/// wrist path at the output rate.
+struct Reported {
+    report: SegmentReport,
+    reference: Vec<(Real, Vector3)>,
+}
+
 /// The planning state between actions.
 struct Solver<'a> {
     robot: &'a Robot,
@@ -469,7 +479,7 @@ struct Solver<'a> {
     q: JointVector,
     /// Segments solved so far.
     solved: usize,
-    /// The solved segments with their reports, in order, once every report is written.
+    /// The segments solved, in order.
     pieces: Vec<Piece>,
     /// Warnings other than missed goals: fallbacks and stretched durations.
     notes: Vec<Warning>,
@@ -540,10 +550,20 @@ impl<'a> Solver<'a> {
                 progress(&Progress { done, total, action: name.clone(), segment: k, fraction })
             };
             report(0.0);
-            let solution = self.solve(&job, &mut Monitor::new(self.deadline, &mut report))?;
+            let mut solution = self.solve(&job, &mut Monitor::new(self.deadline, &mut report))?;
             if let Some(end) = solution.trajectory.positions().last() {
                 self.q = *end;
             }
+            self.pieces.push(Piece {
+                action: action.index,
+                name: action.name.clone(),
+                segment: k,
+                trajectory: solution.trajectory.clone(),
+                problem: job.problem.clone(),
+                stretch: 1.0,
+                start: 0.0,
+                swivel_map: solution.swivel_map.take(),
+            });
             // The writer is gone only when it panicked, which its join passes on.
             let _ = reports.send((self.solved, job, solution));
             self.solved += 1;
@@ -562,9 +582,8 @@ impl<'a> Solver<'a> {
     /// Joins the solved segments into the output at its rate, keeping the limits: each
     /// segment slowed as a whole where it exceeds a rate limit, each +Tr blend shortened where
     /// it does, and the output checked again at every instant until it holds the limits (or
-    /// the rounds run out). Completes the reports with the measures of the output. Returns
-    /// the output and the notes on what was repaired.
-    fn finish(&mut self) -> Result<(Trajectory, Vec<Warning>), SolveError> {
+    /// the rounds run out). Returns the output and the notes on what was repaired.
+    fn join_keeping_limits(&mut self) -> Result<(Trajectory, Vec<Warning>), SolveError> {
         // A copy: joining below borrows the solver.
         let limits = &self.limits.clone();
         self.pieces.par_iter_mut().for_each(|piece| {
@@ -595,30 +614,35 @@ impl<'a> Solver<'a> {
             }
         };
         let mut notes = blend_notes;
-        for piece in &mut self.pieces {
+        for piece in &self.pieces {
             if piece.stretch > 1.0 {
-                let r = &piece.report;
                 let solved = piece.trajectory.duration();
                 let message = format!(
                     "action `{}`, segment {}: slowed down {:.3} times ({:.2} s instead of {:.2} s) \
                      to keep every joint within its velocity and acceleration limits",
-                    r.action,
-                    r.segment + 1,
+                    piece.name,
+                    piece.segment + 1,
                     piece.stretch,
                     solved * piece.stretch,
                     solved
                 );
                 notes.push(Warning::on_segment(
                     WarningKind::SlowedDown,
-                    &r.action,
-                    r.segment,
+                    &piece.name,
+                    piece.segment,
                     message,
                 ));
             }
         }
-        let robot = self.robot;
-        self.pieces.par_iter_mut().for_each(|piece| complete(piece, &output, robot, limits));
         Ok((output, notes))
+    }
+
+    /// Completes each segment's report (in the pieces' order) with where joining put it and
+    /// the measures of the `output`.
+    fn complete(&self, reported: &mut [Reported], output: &Trajectory) {
+        (self.pieces.par_iter().zip(reported)).for_each(|(piece, reported)| {
+            complete(piece, &mut reported.report, output, self.robot, &self.limits)
+        });
     }
 
     /// Every segment joined at its current stretch: +Tr within an action (each blend
@@ -647,19 +671,19 @@ impl<'a> Solver<'a> {
                             })?
                             .unwrap_or(0.0);
                         if used < overlap {
-                            let r = &self.pieces[i].report;
+                            let piece = &self.pieces[i];
                             let message = format!(
                                 "action `{}`, segment {}: the +Tr blend into it overlaps {:.3} s \
                                  instead of {:.3} s to keep the joint limits",
-                                r.action,
-                                r.segment + 1,
+                                piece.name,
+                                piece.segment + 1,
                                 used,
                                 overlap
                             );
                             notes.push(Warning::on_segment(
                                 WarningKind::BlendShortened,
-                                &r.action,
-                                r.segment,
+                                &piece.name,
+                                piece.segment,
                                 message,
                             ));
                         }
@@ -996,23 +1020,13 @@ struct Reporter<'a> {
 }
 
 impl Reporter<'_> {
-    /// The solved segment judged (where that waited for the report), reported, and ready to
-    /// be joined.
-    fn piece(&self, job: Job, mut solution: Solved) -> Piece {
+    /// The solved segment judged (where that waited for the report) and reported.
+    fn report(&self, job: Job, mut solution: Solved) -> Reported {
         let path = (solution.path.take())
             .unwrap_or_else(|| judge_path(self.robot, &job, &self.tolerance, &solution.trajectory));
         let reference = self.reference(&job.problem);
-        let report = self.report(&job, &solution, &path);
-        Piece {
-            action: job.action.index,
-            trajectory: solution.trajectory,
-            report,
-            reference,
-            problem: job.problem,
-            stretch: 1.0,
-            start: 0.0,
-            swivel_map: solution.swivel_map,
-        }
+        let report = self.segment_report(&job, &solution, &path);
+        Reported { report, reference }
     }
 
     /// The segment's reference Pw at the output rate, in its own time.
@@ -1025,7 +1039,7 @@ impl Reporter<'_> {
 
     /// The segment's report as solved, in its own time; [`complete`] adds what joining
     /// decides and the measures of the output.
-    fn report(&self, job: &Job, solution: &Solved, path: &PathJudgement) -> SegmentReport {
+    fn segment_report(&self, job: &Job, solution: &Solved, path: &PathJudgement) -> SegmentReport {
         let tolerance = &self.tolerance;
         let error = |variable: Variable, error: Real| VariableError {
             variable,
@@ -1167,9 +1181,14 @@ fn featured_peaks(variable: &Variable, times: &[Real], states: &[Option<ArmState
 
 /// Completes a segment's report with where joining put it and the measures of the output
 /// over its time: peak rate ratios, whether the limits hold, the normalised jerks.
-fn complete(piece: &mut Piece, output: &Trajectory, robot: &Robot, limits: &Limits) {
+fn complete(
+    piece: &Piece,
+    report: &mut SegmentReport,
+    output: &Trajectory,
+    robot: &Robot,
+    limits: &Limits,
+) {
     let (start, stretch, solved) = (piece.start, piece.stretch, piece.trajectory.duration());
-    let report = &mut piece.report;
     report.start = start;
     report.end = start + solved * stretch;
     report.settle *= stretch;

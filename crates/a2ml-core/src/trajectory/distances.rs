@@ -6,6 +6,8 @@
 //! gives both the per-capsule series and the sample's clearance (the smallest of those pairs,
 //! as [`super::min_clearance`] finds it).
 
+use rayon::prelude::*;
+
 use crate::collision::{CollisionModel, CollisionScene, Pair};
 use crate::language::Obstacle;
 use crate::math::Real;
@@ -37,6 +39,9 @@ pub struct DistancePass {
     /// samples, at its first worst sample; `None` when no pair was measured.
     pub clearance: Option<Clearance>,
 }
+
+/// One sample's row of capsule-obstacle distances (`None`: not measured) and its nearest pair.
+type SampleMeasure = (Vec<Option<Real>>, Option<(Real, Pair)>);
 
 /// The signed distance of every moving capsule to every obstacle of `scene` (in {b}) at each
 /// sample; [`DistancePass::distances`] of [`distance_pass`].
@@ -78,29 +83,45 @@ pub fn distance_pass(
     for (j, &i) in moving.iter().enumerate() {
         slot_of[i] = Some(j);
     }
+    // Which obstacles each sample's action touches, asked in the samples' order.
+    let touched: Vec<Vec<bool>> = (0..trajectory.len())
+        .map(|sample| scene.iter().map(|o| contact(sample, &o.name)).collect())
+        .collect();
+    // Each sample measured on its own (on the thread pool): its row of capsule-obstacle
+    // distances and its nearest pair (the first of the smallest, in the model's order).
+    let width = distances.len();
+    let measured: Vec<SampleMeasure> = (trajectory.positions())
+        .par_iter()
+        .zip(&touched)
+        .map(|(q, touched)| {
+            let mut row = vec![None; width];
+            let mut nearest: Option<(Real, Pair)> = None;
+            model.measure_pairs(q, |pair, distance| {
+                if let Pair::Obstacle { capsule, obstacle } = pair {
+                    if touched[obstacle] {
+                        return;
+                    }
+                    if let Some(j) = slot_of[capsule] {
+                        row[obstacle * moving.len() + j] = Some(distance);
+                    }
+                }
+                if nearest.is_none_or(|(d, _)| distance < d) {
+                    nearest = Some((distance, pair));
+                }
+            });
+            (row, nearest)
+        })
+        .collect();
+    // The clearance at the first of the smallest samples, as one pass in order finds it.
     let mut clearance: Option<(Real, Real, Pair)> = None;
-    let mut row: Vec<Option<Real>> = vec![None; distances.len()];
-    let mut touched: Vec<bool> = vec![false; scene.len()];
-    for (sample, (&time, q)) in trajectory.times().iter().zip(trajectory.positions()).enumerate() {
-        for (k, o) in scene.iter().enumerate() {
-            touched[k] = contact(sample, &o.name);
+    for ((row, nearest), &time) in measured.into_iter().zip(trajectory.times()) {
+        for (series, value) in distances.iter_mut().zip(row) {
+            series.distance.push(value);
         }
-        row.fill(None);
-        model.measure_pairs(q, |pair, distance| {
-            if let Pair::Obstacle { capsule, obstacle } = pair {
-                if touched[obstacle] {
-                    return;
-                }
-                if let Some(j) = slot_of[capsule] {
-                    row[obstacle * moving.len() + j] = Some(distance);
-                }
-            }
+        if let Some((distance, pair)) = nearest {
             if clearance.is_none_or(|(d, _, _)| distance < d) {
                 clearance = Some((distance, time, pair));
             }
-        });
-        for (series, value) in distances.iter_mut().zip(&row) {
-            series.distance.push(*value);
         }
     }
     let clearance = clearance.map(|(distance, time, pair)| {
