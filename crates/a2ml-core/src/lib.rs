@@ -23,6 +23,7 @@ pub mod math;
 pub mod metrics;
 pub mod names;
 pub mod output;
+mod parallel;
 pub mod profile;
 pub mod robot;
 pub mod solve;

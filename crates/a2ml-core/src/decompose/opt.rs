@@ -12,8 +12,6 @@
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use rayon::prelude::*;
-
 use crate::collision::{CollisionModel, CollisionScene, min_distance};
 use crate::kinematics::{
     CpsaState, HatState, KinematicsError, arm_pose, cpsa_state, cpsa_to_hat, hat_state,
@@ -25,6 +23,7 @@ use crate::language::{
 use crate::math::{
     DOF, JointVector, PI, Real, Rotation3, Vector3, rotation_about, rotation_log, wrap_angle,
 };
+use crate::parallel;
 use crate::profile::SemiEllipse;
 use crate::robot::Robot;
 
@@ -613,19 +612,17 @@ impl Search<'_> {
     ) -> Vec<(Vec<Real>, ArmState, JointVector, Real)> {
         // The first start known to meet the tolerance.
         let first_met = AtomicUsize::new(usize::MAX);
-        let searched: Vec<_> = (starts.par_iter().enumerate())
-            .map(|(i, x0)| {
-                if i > first_met.load(Ordering::Relaxed) {
-                    return None;
-                }
-                let mut search = Search { measured: None, evaluations: 0, ..self.clone() };
-                let local = search.minimise(x0.clone());
-                if local.as_ref().is_some_and(|l| l.3 < self.options.tolerance) {
-                    first_met.fetch_min(i, Ordering::Relaxed);
-                }
-                Some((local, search.evaluations))
-            })
-            .collect();
+        let searched: Vec<_> = parallel::map(starts, |i, x0| {
+            if i > first_met.load(Ordering::Relaxed) {
+                return None;
+            }
+            let mut search = Search { measured: None, evaluations: 0, ..self.clone() };
+            let local = search.minimise(x0.clone());
+            if local.as_ref().is_some_and(|l| l.3 < self.options.tolerance) {
+                first_met.fetch_min(i, Ordering::Relaxed);
+            }
+            Some((local, search.evaluations))
+        });
         let mut found = Vec::new();
         // Every start up to the first that met the tolerance was searched.
         for (local, evaluations) in searched.into_iter().map_while(|s| s) {

@@ -10,8 +10,6 @@
 
 use std::sync::Mutex;
 use std::sync::mpsc::{Sender, channel};
-
-use rayon::prelude::*;
 use std::time::Instant;
 
 use super::assembly::Assembly;
@@ -42,6 +40,7 @@ use crate::kinematics::{HatState, arm_pose, hat_to_cpsa, ik_cpsa};
 use crate::language::{self, ActionBody, PrimitiveConstraint, SolverChoice, Space, Task, Variable};
 use crate::math::{DOF, JointVector, Real, Vector3};
 use crate::metrics::smoothness::{normalised_jerk, speed_peaks};
+use crate::parallel;
 use crate::profile::{BodyFrames, ProfileError, Reference, Role, Sample};
 use crate::robot::Robot;
 use crate::trajectory::{self, Limits, Trajectory, TrajectoryError, capsule_distances, peaks};
@@ -379,7 +378,7 @@ pub fn plan_with_progress(
     // Each segment's start and action, for the obstacles an action touches on purpose.
     let spans: Vec<(Real, usize)> = state.pieces.iter().map(|p| (p.start, p.action)).collect();
     // The references and the output's distances, side by side on the thread pool.
-    let ((references, reference_ends), distances) = rayon::join(
+    let ((references, reference_ends), distances) = parallel::join(
         || (reference_samples(robot, &placed, whole.times()), reference_ends(robot, &placed)),
         || {
             capsule_distances(&whole, robot, &task_b.scene, |sample, obstacle| {
@@ -586,7 +585,7 @@ impl<'a> Solver<'a> {
     fn join_keeping_limits(&mut self) -> Result<(Trajectory, Vec<Warning>), SolveError> {
         // A copy: joining below borrows the solver.
         let limits = &self.limits.clone();
-        self.pieces.par_iter_mut().for_each(|piece| {
+        parallel::map_mut(&mut self.pieces, |_, piece| {
             let t = &piece.trajectory;
             let stretch = peaks(t, t.start(), t.end()).stretch(limits);
             if stretch > 1.0 + LIMIT_TOLERANCE {
@@ -598,7 +597,7 @@ impl<'a> Solver<'a> {
             let (whole, notes) = self.join_all()?;
             let output = whole.resample(self.rate)?;
             round += 1;
-            let again = self.pieces.par_iter_mut().map(|piece| {
+            let slowed = parallel::map_mut(&mut self.pieces, |_, piece| {
                 let end = piece.start + piece.trajectory.duration() * piece.stretch;
                 let stretch = peaks(&output, piece.start, end).stretch(limits);
                 let slowed = stretch > 1.0 + LIMIT_TOLERANCE && round < OUTPUT_ROUNDS;
@@ -609,7 +608,7 @@ impl<'a> Solver<'a> {
                 }
                 slowed
             });
-            if !again.reduce(|| false, |a, b| a || b) {
+            if !slowed.contains(&true) {
                 break (output, notes);
             }
         };
@@ -640,8 +639,8 @@ impl<'a> Solver<'a> {
     /// Completes each segment's report (in the pieces' order) with where joining put it and
     /// the measures of the `output`.
     fn complete(&self, reported: &mut [Reported], output: &Trajectory) {
-        (self.pieces.par_iter().zip(reported)).for_each(|(piece, reported)| {
-            complete(piece, &mut reported.report, output, self.robot, &self.limits)
+        parallel::map_mut(reported, |i, reported| {
+            complete(&self.pieces[i], &mut reported.report, output, self.robot, &self.limits)
         });
     }
 

@@ -6,11 +6,10 @@
 //! gives both the per-capsule series and the sample's clearance (the smallest of those pairs,
 //! as [`super::min_clearance`] finds it).
 
-use rayon::prelude::*;
-
 use crate::collision::{CollisionModel, CollisionScene, Pair};
 use crate::language::Obstacle;
 use crate::math::Real;
+use crate::parallel;
 use crate::robot::Robot;
 
 use super::{Clearance, Trajectory};
@@ -90,28 +89,25 @@ pub fn distance_pass(
     // Each sample measured on its own (on the thread pool): its row of capsule-obstacle
     // distances and its nearest pair (the first of the smallest, in the model's order).
     let width = distances.len();
-    let measured: Vec<SampleMeasure> = (trajectory.positions())
-        .par_iter()
-        .zip(&touched)
-        .map(|(q, touched)| {
-            let mut row = vec![None; width];
-            let mut nearest: Option<(Real, Pair)> = None;
-            model.measure_pairs(q, |pair, distance| {
-                if let Pair::Obstacle { capsule, obstacle } = pair {
-                    if touched[obstacle] {
-                        return;
-                    }
-                    if let Some(j) = slot_of[capsule] {
-                        row[obstacle * moving.len() + j] = Some(distance);
-                    }
+    let measured: Vec<SampleMeasure> = parallel::map(trajectory.positions(), |sample, q| {
+        let touched = &touched[sample];
+        let mut row = vec![None; width];
+        let mut nearest: Option<(Real, Pair)> = None;
+        model.measure_pairs(q, |pair, distance| {
+            if let Pair::Obstacle { capsule, obstacle } = pair {
+                if touched[obstacle] {
+                    return;
                 }
-                if nearest.is_none_or(|(d, _)| distance < d) {
-                    nearest = Some((distance, pair));
+                if let Some(j) = slot_of[capsule] {
+                    row[obstacle * moving.len() + j] = Some(distance);
                 }
-            });
-            (row, nearest)
-        })
-        .collect();
+            }
+            if nearest.is_none_or(|(d, _)| distance < d) {
+                nearest = Some((distance, pair));
+            }
+        });
+        (row, nearest)
+    });
     // The clearance at the first of the smallest samples, as one pass in order finds it.
     let mut clearance: Option<(Real, Real, Pair)> = None;
     for ((row, nearest), &time) in measured.into_iter().zip(trajectory.times()) {
