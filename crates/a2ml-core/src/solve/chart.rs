@@ -332,15 +332,19 @@ impl Chart {
 
     /// The path components whose reference moves.
     fn moving(&self) -> impl Iterator<Item = usize> + '_ {
-        (0..3).filter(|&k| self.on_path[k] && self.references[k].bell().distance() > 0.0)
+        (0..3).filter(|&k| self.moves(k))
+    }
+
+    /// Whether component `k` is on the path and its reference moves.
+    fn moves(&self, k: usize) -> bool {
+        self.on_path[k] && self.references[k].bell().distance() > 0.0
     }
 
     /// Each moving path component's nearest σ in closed form (unclamped), `None` for the
     /// others.
     fn own_nearest(&self, state: &ArmState) -> [Option<Real>; 3] {
         std::array::from_fn(|k| {
-            let moves = self.on_path[k] && self.references[k].bell().distance() > 0.0;
-            moves
+            (self.moves(k))
                 .then(|| self.references[k].nearest_fraction(&state.value(self.variables[k])))
                 .flatten()
         })

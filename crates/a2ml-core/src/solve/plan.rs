@@ -316,7 +316,6 @@ pub fn plan_with_progress(
         deadline,
         rate,
         q: decomposition.start,
-        solved: 0,
         pieces: Vec::with_capacity(total),
         notes: Vec::new(),
     };
@@ -476,8 +475,6 @@ struct Solver<'a> {
     rate: Real,
     /// Where the arm really is: the end of what has been solved.
     q: JointVector,
-    /// Segments solved so far.
-    solved: usize,
     /// The segments solved, in order.
     pieces: Vec<Piece>,
     /// Warnings other than missed goals: fallbacks and stretched durations.
@@ -539,7 +536,7 @@ impl<'a> Solver<'a> {
                 .iter()
                 .any(|p| matches!(p.constraint, PrimitiveConstraint::Path(_)));
             let job = Job { action, k, segment, problem, scene, chart, hard: hard && carries_path };
-            let done = self.solved;
+            let done = self.pieces.len();
             let name = action.name.clone();
             // Never backwards, when `auto` goes on from one solver to another.
             let mut most: Real = 0.0;
@@ -564,9 +561,8 @@ impl<'a> Solver<'a> {
                 swivel_map: solution.swivel_map.take(),
             });
             // The writer is gone only when it panicked, which its join passes on.
-            let _ = reports.send((self.solved, job, solution));
-            self.solved += 1;
-            let done = self.solved;
+            let _ = reports.send((done, job, solution));
+            let done = self.pieces.len();
             progress(&Progress {
                 done,
                 total,
@@ -583,11 +579,9 @@ impl<'a> Solver<'a> {
     /// it does, and the output checked again at every instant until it holds the limits (or
     /// the rounds run out). Returns the output and the notes on what was repaired.
     fn join_keeping_limits(&mut self) -> Result<(Trajectory, Vec<Warning>), SolveError> {
-        // A copy: joining below borrows the solver.
-        let limits = &self.limits.clone();
         parallel::map_mut(&mut self.pieces, |_, piece| {
             let t = &piece.trajectory;
-            let stretch = peaks(t, t.start(), t.end()).stretch(limits);
+            let stretch = peaks(t, t.start(), t.end()).stretch(&self.limits);
             if stretch > 1.0 + LIMIT_TOLERANCE {
                 piece.stretch = stretch * (1.0 + 1e-6);
             }
@@ -599,7 +593,7 @@ impl<'a> Solver<'a> {
             round += 1;
             let slowed = parallel::map_mut(&mut self.pieces, |_, piece| {
                 let end = piece.start + piece.trajectory.duration() * piece.stretch;
-                let stretch = peaks(&output, piece.start, end).stretch(limits);
+                let stretch = peaks(&output, piece.start, end).stretch(&self.limits);
                 let slowed = stretch > 1.0 + LIMIT_TOLERANCE && round < OUTPUT_ROUNDS;
                 if slowed {
                     // A little more than asked: the output's samples fall elsewhere on the
@@ -1010,7 +1004,7 @@ impl<'a> Solver<'a> {
 }
 
 /// What a segment's report reads besides the segment: the robot, the tolerance and the
-/// output rate, shared by the reports written on the thread pool.
+/// output rate, for the thread that writes the reports.
 #[derive(Clone, Copy)]
 struct Reporter<'a> {
     robot: &'a Robot,
