@@ -65,17 +65,79 @@ impl Assembly {
 
     /// The whole trajectory; `None` when nothing was joined.
     pub(super) fn finish(self) -> Result<Option<Trajectory>, TrajectoryError> {
-        let Some(open) = self.open else { return Ok(None) };
-        if self.done.is_empty() {
-            return Ok(Some(open));
+        match self.open {
+            Some(open) if self.done.is_empty() => Ok(Some(open)),
+            _ => self.assembled(),
         }
-        let pieces = || self.done.iter().chain(std::iter::once(&open));
+    }
+
+    /// The whole trajectory so far, the assembly left as it is; `None` when nothing was
+    /// joined.
+    fn assembled(&self) -> Result<Option<Trajectory>, TrajectoryError> {
+        let Some(open) = &self.open else { return Ok(None) };
+        let pieces = || self.done.iter().chain(std::iter::once(open));
         Trajectory::new(
             pieces().flat_map(|p| p.times().iter().copied()).collect(),
             pieces().flat_map(|p| p.positions().iter().copied()).collect(),
             pieces().flat_map(|p| p.velocities().iter().copied()).collect(),
         )
         .map(Some)
+    }
+}
+
+/// An [`Assembly`] joined group by group (the plan's actions) that keeps where it stood after
+/// each group, with the group's notes, so that joining again after a later group changed
+/// starts from the end of the group before it: what was joined before a group does not
+/// depend on it. The plan's limit rounds slow a few segments at a time and rejoin from the
+/// first action they changed.
+#[derive(Debug)]
+pub(super) struct Checkpointed<N> {
+    assembly: Assembly,
+    after: Vec<Checkpoint<N>>,
+}
+
+/// Where a [`Checkpointed`] assembly stood after one group: how many pieces were done (later
+/// ones are never changed, only more are pushed), the open piece, and the group's notes.
+#[derive(Debug)]
+struct Checkpoint<N> {
+    done: usize,
+    open: Option<Trajectory>,
+    notes: Vec<N>,
+}
+
+impl<N> Default for Checkpointed<N> {
+    fn default() -> Self {
+        Self { assembly: Assembly::default(), after: Vec::new() }
+    }
+}
+
+impl<N: Clone> Checkpointed<N> {
+    /// Forgets group `group` and every later one: the assembly as it stood after the group
+    /// before (empty for the first), to join group `group` on. `group` is at most the number
+    /// of groups closed.
+    pub(super) fn rewind(&mut self, group: usize) -> &mut Assembly {
+        self.after.truncate(group);
+        match self.after.last() {
+            Some(checkpoint) => {
+                self.assembly.done.truncate(checkpoint.done);
+                self.assembly.open.clone_from(&checkpoint.open);
+            }
+            None => self.assembly = Assembly::default(),
+        }
+        &mut self.assembly
+    }
+
+    /// Closes a group joined since the last checkpoint, with its notes.
+    pub(super) fn close_group(&mut self, notes: Vec<N>) {
+        let (done, open) = (self.assembly.done.len(), self.assembly.open.clone());
+        self.after.push(Checkpoint { done, open, notes });
+    }
+
+    /// The whole trajectory so far and every closed group's notes in order; `None` when
+    /// nothing was joined.
+    pub(super) fn assembled(&self) -> Result<(Option<Trajectory>, Vec<N>), TrajectoryError> {
+        let notes = self.after.iter().flat_map(|c| c.notes.iter().cloned()).collect();
+        Ok((self.assembly.assembled()?, notes))
     }
 }
 
@@ -102,6 +164,37 @@ mod tests {
             (JointVector::repeat(a + (b - a) * s), JointVector::repeat((b - a) * ds))
         })
         .expect("valid")
+    }
+
+    #[test]
+    fn rewinding_to_a_group_and_joining_again_gives_the_same_bits() {
+        let pieces =
+            [ramp(0.0, 1.0, 41), ramp(1.0, 0.5, 33), ramp(0.5, 2.0, 57), ramp(2.0, 0.0, 9)];
+        let mut checkpointed = Checkpointed::default();
+        for (k, piece) in pieces.iter().enumerate() {
+            checkpointed.rewind(k).join_sequential(piece).expect("+Se");
+            checkpointed.close_group(vec![k]);
+        }
+        let (first, notes) = checkpointed.assembled().expect("assembled");
+        assert_eq!(notes, [0, 1, 2, 3]);
+        // Group 2 joined differently, then as before: the first two groups are kept.
+        let other = ramp(0.5, 1.5, 20);
+        checkpointed.rewind(2).join_sequential(&other).expect("+Se");
+        checkpointed.close_group(vec![7]);
+        let (changed, notes) = checkpointed.assembled().expect("assembled");
+        assert_eq!(notes, [0, 1, 7]);
+        assert_ne!(changed, first);
+        for (k, piece) in pieces.iter().enumerate().skip(2) {
+            checkpointed.rewind(k).join_sequential(piece).expect("+Se");
+            checkpointed.close_group(vec![k]);
+        }
+        let (again, notes) = checkpointed.assembled().expect("assembled");
+        assert_eq!(notes, [0, 1, 2, 3]);
+        assert_eq!(again, first);
+        let mut whole = Assembly::default();
+        pieces.iter().for_each(|p| whole.join_sequential(p).expect("+Se"));
+        assert_eq!(whole.finish().expect("finished"), first);
+        assert_eq!(checkpointed.rewind(0).end(), None);
     }
 
     #[test]

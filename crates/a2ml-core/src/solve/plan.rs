@@ -12,7 +12,7 @@ use std::sync::Mutex;
 use std::sync::mpsc::{Sender, channel};
 use std::time::Instant;
 
-use super::assembly::Assembly;
+use super::assembly::{Assembly, Checkpointed};
 use super::chart::Chart;
 use super::checks::{self, CheckError};
 use super::constrained_rrt::constrained_rrt_monitored;
@@ -586,9 +586,16 @@ impl<'a> Solver<'a> {
                 piece.stretch = stretch * (1.0 + 1e-6);
             }
         });
+        // The index of each action's first piece: a round rejoins from the first action it
+        // slowed a piece of.
+        let action_starts: Vec<usize> = (0..self.pieces.len())
+            .filter(|&i| i == 0 || self.pieces[i].action != self.pieces[i - 1].action)
+            .collect();
+        let mut joined = Checkpointed::default();
+        let mut from = 0;
         let mut round = 0;
         let (output, blend_notes) = loop {
-            let (whole, notes) = self.join_all()?;
+            let (whole, notes) = self.join_from(&mut joined, &action_starts, from)?;
             let output = whole.resample(self.rate)?;
             round += 1;
             let slowed = parallel::map_mut(&mut self.pieces, |_, piece| {
@@ -602,8 +609,9 @@ impl<'a> Solver<'a> {
                 }
                 slowed
             });
-            if !slowed.contains(&true) {
-                break (output, notes);
+            match slowed.iter().position(|&slowed| slowed) {
+                Some(first) => from = action_starts.partition_point(|&start| start <= first) - 1,
+                None => break (output, notes),
             }
         };
         let mut notes = blend_notes;
@@ -639,18 +647,25 @@ impl<'a> Solver<'a> {
     }
 
     /// Every segment joined at its current stretch: +Tr within an action (each blend
-    /// shortened where it would exceed a limit), +Se between actions. Sets each piece's start;
-    /// returns the trajectory and a note per shortened blend.
-    fn join_all(&mut self) -> Result<(Trajectory, Vec<Warning>), SolveError> {
-        let mut notes = Vec::new();
+    /// shortened where it would exceed a limit), +Se between actions; `joined` is kept as
+    /// joined up to action `from` (of those starting at the pieces `action_starts`) and
+    /// joined again from there. Sets the start of each piece joined; returns the trajectory
+    /// and a note per shortened blend.
+    fn join_from(
+        &mut self,
+        joined: &mut Checkpointed<Warning>,
+        action_starts: &[usize],
+        from: usize,
+    ) -> Result<(Trajectory, Vec<Warning>), SolveError> {
         // Each join only changes the samples from its seam on, so only the tail is rebuilt:
         // joining stays linear in the number of segments.
-        let mut whole = Assembly::default();
-        let mut i = 0;
-        while i < self.pieces.len() {
+        for (k, &first) in action_starts.iter().enumerate().skip(from) {
+            let whole = joined.rewind(k);
+            let mut notes = Vec::new();
+            let mut i = first;
             let action = self.pieces[i].action;
             let action_start = whole.end().unwrap_or(0.0);
-            let mut joined = Assembly::default();
+            let mut action_joined = Assembly::default();
             let mut last: Option<(Real, Real)> = None; // (start, duration) of the previous segment
             while i < self.pieces.len() && self.pieces[i].action == action {
                 let segment = self.pieces[i].timed();
@@ -658,7 +673,7 @@ impl<'a> Solver<'a> {
                 let start = match last {
                     Some((prev_start, prev_duration)) => {
                         let overlap = self.task.settings.transition * prev_duration.min(duration);
-                        let used = joined
+                        let used = action_joined
                             .join_with(&segment, overlap, |before, next| {
                                 self.blend(before, next, overlap)
                             })?
@@ -683,7 +698,7 @@ impl<'a> Solver<'a> {
                         prev_start + prev_duration - used
                     }
                     None => {
-                        joined.join_sequential(&shifted(&segment, action_start)?)?;
+                        action_joined.join_sequential(&shifted(&segment, action_start)?)?;
                         action_start
                     }
                 };
@@ -691,12 +706,13 @@ impl<'a> Solver<'a> {
                 self.pieces[i].start = start;
                 i += 1;
             }
-            if let Some(action_trajectory) = joined.finish()? {
+            if let Some(action_trajectory) = action_joined.finish()? {
                 whole.join_sequential(&action_trajectory)?;
             }
+            joined.close_group(notes);
         }
-        let whole = whole.finish()?.ok_or(TrajectoryError::Empty)?;
-        Ok((whole, notes))
+        let (trajectory, notes) = joined.assembled()?;
+        Ok((trajectory.ok_or(TrajectoryError::Empty)?, notes))
     }
 
     /// The +Tr blend of `before` (ending with a segment at rest) into `next` (starting at rest

@@ -9,6 +9,8 @@
 //! samples' q and q', so the two stay consistent and the limits are checked at every instant
 //! of that curve, not only at the samples.
 
+use std::cell::Cell;
+
 use crate::collision::{self, CollisionScene, MEASURE_SLACK, clearance_bound};
 use crate::math::{DOF, JointVector, Real};
 use crate::profile::ProfileError;
@@ -193,8 +195,39 @@ impl Trajectory {
     /// interpolation of the neighbouring samples' q and q'.
     pub fn sample(&self, t: Real) -> JointSample {
         let t = t.clamp(self.start(), self.end());
-        // The interval [t_k, t_k+1] holding t.
-        let k = self.times.partition_point(|&s| s <= t).saturating_sub(1);
+        self.interpolate(self.interval(t), t)
+    }
+
+    /// [`Trajectory::sample`] for times that mostly rise, as joining and resampling ask:
+    /// the interval is looked for where the last call found it and in the one after before
+    /// it is bisected for. The same values as `sample`, bit for bit.
+    fn sampler(&self) -> impl Fn(Real) -> JointSample + '_ {
+        let last = Cell::new(0);
+        move |t| {
+            let t = t.clamp(self.start(), self.end());
+            let holds = |k: usize| {
+                k < self.len()
+                    && self.times[k] <= t
+                    && self.times.get(k + 1).is_none_or(|&next| t < next)
+            };
+            let k = [last.get(), last.get() + 1]
+                .into_iter()
+                .find(|&k| holds(k))
+                .unwrap_or_else(|| self.interval(t));
+            last.set(k);
+            self.interpolate(k, t)
+        }
+    }
+
+    /// The index k of the interval [t_k, t_k+1) holding `t` (the last sample's at or after
+    /// it): the number of samples at or before `t`, less one.
+    fn interval(&self, t: Real) -> usize {
+        self.times.partition_point(|&s| s <= t).saturating_sub(1)
+    }
+
+    /// The cubic Hermite curve of interval `k` at `t` (within it); the last sample from its
+    /// last index on.
+    fn interpolate(&self, k: usize, t: Real) -> JointSample {
         if k + 1 >= self.len() {
             return (self.positions[k], self.velocities[k]);
         }
@@ -222,7 +255,7 @@ impl Trajectory {
         if !(rate_hz.is_finite() && rate_hz > 0.0) {
             return Err(TrajectoryError::InvalidRate { rate_hz });
         }
-        Self::from_fn(sample_times(self.start(), self.end(), rate_hz), |t| self.sample(t))
+        Self::from_fn(sample_times(self.start(), self.end(), rate_hz), self.sampler())
     }
 
     /// The same motion `factor` times slower: times from the start times `factor`, q' divided
@@ -239,7 +272,8 @@ impl Trajectory {
 
     /// `sample` in local time (0 at the first sample).
     fn local(&self) -> impl Fn(Real) -> JointSample + '_ {
-        move |t| self.sample(self.start() + t)
+        let sample = self.sampler();
+        move |t| sample(self.start() + t)
     }
 }
 

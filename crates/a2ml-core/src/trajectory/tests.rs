@@ -296,3 +296,37 @@ fn min_clearance_equals_measuring_every_sample() {
     }
     assert!(skipped_any, "no motion stayed clear: the bound was never tried");
 }
+
+#[test]
+fn the_sampler_gives_the_samples_bits_at_any_time_in_any_order() {
+    use rand::rngs::StdRng;
+    use rand::{RngExt, SeedableRng};
+    // Uneven sample times, so that intervals differ in length.
+    let mut rng = StdRng::seed_from_u64(3);
+    let times: Vec<Real> = (0..200)
+        .scan(0.0, |t, _| {
+            *t += rng.random_range(1e-3..0.05);
+            Some(*t)
+        })
+        .collect();
+    let tr = Trajectory::from_fn(times, |t| {
+        (JointVector::repeat(t.sin()), JointVector::repeat(t.cos()))
+    })
+    .expect("valid");
+    let (start, end) = (tr.start(), tr.end());
+    let rising: Vec<Real> =
+        (0..=1000).map(|i| start + (end - start) * i as Real / 1000.0).collect();
+    let mut queries: Vec<Real> = tr.times().to_vec();
+    queries.extend(&rising);
+    queries.extend(rising.iter().rev());
+    queries.extend((0..500).map(|_| rng.random_range(start - 1.0..end + 1.0)));
+    queries.extend([start - 1.0, start, end, end + 1.0, end, start]);
+    let sampler = tr.sampler();
+    for &t in &queries {
+        let ((q, dq), (sq, sdq)) = (sampler(t), tr.sample(t));
+        for i in 0..DOF {
+            assert_eq!(q[i].to_bits(), sq[i].to_bits(), "q at {t}");
+            assert_eq!(dq[i].to_bits(), sdq[i].to_bits(), "q' at {t}");
+        }
+    }
+}
