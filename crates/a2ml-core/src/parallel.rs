@@ -6,6 +6,9 @@
 //! Many tasks at once run on the same pool (the CLI's batches, `a2ml.plan_many`): a task's
 //! pieces then mostly run on its own thread, and nothing waits for a thread that is busy.
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Mutex, PoisonError};
+
 use rayon::prelude::*;
 
 /// `f(i, &items[i])` for every item, on the pool, in the items' order.
@@ -27,6 +30,50 @@ pub(crate) fn join<A: Send, B: Send>(
     b: impl FnOnce() -> B + Send,
 ) -> (A, B) {
     rayon::join(a, b)
+}
+
+/// `f(i, &items[i], abandoned)` for the items in turn until the first call that says its
+/// item is the last wanted (`(_, true)`): each of the pool's threads takes the lowest item
+/// not yet taken, so the items are begun in order, and none after the last wanted one is
+/// begun once it is known; `abandoned()` tells a call still running on a later item that
+/// its result will be thrown away, so that it may stop early. Returns the results of the
+/// items up to the last wanted one (every item's when none is), in order: the same as
+/// calling `f` on one item after the other and stopping after the last wanted one, so long
+/// as `f` gives the same result whichever thread calls it and `abandoned()` is only
+/// consulted to stop.
+pub(crate) fn in_turn_until<T: Sync, R: Send>(
+    items: &[T],
+    f: impl Fn(usize, &T, &dyn Fn() -> bool) -> (R, bool) + Sync,
+) -> Vec<R> {
+    let next = AtomicUsize::new(0);
+    // The lowest item known to be the last wanted.
+    let last = AtomicUsize::new(usize::MAX);
+    let results: Vec<Mutex<Option<R>>> = items.iter().map(|_| Mutex::new(None)).collect();
+    let take_in_turn = || {
+        loop {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            if i >= items.len() || i > last.load(Ordering::Relaxed) {
+                break;
+            }
+            let abandoned = || i > last.load(Ordering::Relaxed);
+            let (result, is_last) = f(i, &items[i], &abandoned);
+            if is_last {
+                last.fetch_min(i, Ordering::Relaxed);
+            }
+            *results[i].lock().unwrap_or_else(PoisonError::into_inner) = Some(result);
+        }
+    };
+    let threads = rayon::current_num_threads().min(items.len());
+    rayon::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|_| take_in_turn());
+        }
+    });
+    let wanted = last.into_inner().saturating_add(1).min(items.len());
+    // Every item up to the last wanted one was begun (in order) and none was abandoned.
+    (results.into_iter().take(wanted))
+        .map_while(|slot| slot.into_inner().unwrap_or_else(PoisonError::into_inner))
+        .collect()
 }
 
 #[cfg(test)]
@@ -52,6 +99,39 @@ mod tests {
             assert_eq!(old, items);
             assert!(doubled.iter().enumerate().all(|(i, x)| *x == 3 * i as u64));
             assert_eq!(pool.install(|| join(|| 1, || 2)), (1, 2));
+        }
+    }
+
+    #[test]
+    fn items_in_turn_stop_after_the_last_wanted_one_on_any_pool() {
+        let items: Vec<u64> = (0..50).collect();
+        // A slow item, so that later ones run beside it, and items that are the last wanted.
+        let work = |i: usize, x: &u64, abandoned: &dyn Fn() -> bool, last: &[usize]| {
+            let spins = if i == 3 { 200_000 } else { 1_000 };
+            let mut sum = 0u64;
+            for k in 0..spins {
+                if k % 100 == 0 && abandoned() {
+                    return (u64::MAX, false);
+                }
+                sum = sum.wrapping_add(k ^ x);
+            }
+            (sum, last.contains(&i))
+        };
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
+            for last in [vec![], vec![0], vec![3], vec![7, 5], vec![49]] {
+                let alone: Vec<u64> = (items.iter().enumerate())
+                    .map(|(i, x)| work(i, x, &|| false, &last))
+                    .scan(false, |stop, (r, is_last)| {
+                        (!std::mem::replace(stop, is_last)).then_some(r)
+                    })
+                    .collect();
+                let in_turn = pool.install(|| {
+                    in_turn_until(&items, |i, x, abandoned| work(i, x, abandoned, &last))
+                });
+                assert_eq!(in_turn, alone, "{threads} threads, last wanted {last:?}");
+                assert_eq!(in_turn.len(), last.iter().min().map_or(items.len(), |l| l + 1));
+            }
         }
     }
 }

@@ -10,8 +10,6 @@
 //! by [`OptOptions::limit_margin`]. A one-dimensional search over θsw first
 //! samples the closed-form feasible swivel intervals.
 
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use crate::collision::{CollisionModel, CollisionScene, min_distance};
 use crate::kinematics::{
     CpsaState, HatState, KinematicsError, arm_pose, cpsa_state, cpsa_to_hat, hat_state,
@@ -406,7 +404,11 @@ impl Search<'_> {
     }
 
     /// Levenberg-Marquardt from `x0` with a central-difference Jacobian.
-    fn minimise(&mut self, mut x: Vec<Real>) -> Option<(Vec<Real>, ArmState, JointVector, Real)> {
+    fn minimise(
+        &mut self,
+        mut x: Vec<Real>,
+        abandoned: &dyn Fn() -> bool,
+    ) -> Option<(Vec<Real>, ArmState, JointVector, Real)> {
         let n = x.len();
         let mut r = Vec::new();
         let (mut state, mut q) = self.residual(&x, &mut r)?;
@@ -416,6 +418,9 @@ impl Search<'_> {
         for _ in 0..self.options.max_iterations {
             if cost.sqrt() < self.options.tolerance || n == 0 {
                 break;
+            }
+            if abandoned() {
+                return None;
             }
             let m = r.len();
             let mut jac = nalgebra::DMatrix::<Real>::zeros(m, n);
@@ -602,30 +607,23 @@ impl Search<'_> {
     /// tolerance.
     ///
     /// Each start is searched on its own, from no measured clearance, so that the starts are
-    /// searched side by side on the thread pool; a start after one that met the tolerance is
-    /// left out (or its search is thrown away), and the results are read in order, so that
-    /// the optima and the count of evaluations are those of searching one start after the
-    /// other.
+    /// searched side by side on the thread pool, begun in order; a start after one that met
+    /// the tolerance is not begun, or its search stops at its next iteration and is thrown
+    /// away, and the results are read in order, so that the optima and the count of
+    /// evaluations are those of searching one start after the other.
     fn multistart(
         &mut self,
         starts: &[Vec<Real>],
     ) -> Vec<(Vec<Real>, ArmState, JointVector, Real)> {
-        // The first start known to meet the tolerance.
-        let first_met = AtomicUsize::new(usize::MAX);
-        let searched: Vec<_> = parallel::map(starts, |i, x0| {
-            if i > first_met.load(Ordering::Relaxed) {
-                return None;
-            }
+        let searched = parallel::in_turn_until(starts, |_, x0, abandoned| {
             let mut search = Search { measured: None, evaluations: 0, ..self.clone() };
-            let local = search.minimise(x0.clone());
-            if local.as_ref().is_some_and(|l| l.3 < self.options.tolerance) {
-                first_met.fetch_min(i, Ordering::Relaxed);
-            }
-            Some((local, search.evaluations))
+            let local = search.minimise(x0.clone(), abandoned);
+            let met = local.as_ref().is_some_and(|l| l.3 < self.options.tolerance);
+            ((local, search.evaluations), met)
         });
         let mut found = Vec::new();
         // Every start up to the first that met the tolerance was searched.
-        for (local, evaluations) in searched.into_iter().map_while(|s| s) {
+        for (local, evaluations) in searched {
             self.evaluations += evaluations;
             let Some(local) = local else { continue };
             let met = local.3 < self.options.tolerance;
