@@ -1,6 +1,6 @@
-//! Work shared out on the thread pool (rayon's global pool, or the pool a caller installs):
-//! one planned task's independent pieces, Opt1/Opt2's starts, a plan's segments, the
-//! output's samples. Each piece is computed alone and the results come back in the pieces'
+//! Work shared out between the calling thread and the thread pool (rayon's global pool, or
+//! the pool a caller installs): one planned task's independent pieces, Opt1/Opt2's starts,
+//! a plan's segments, the output's samples. Each piece is computed alone and the results come back in the pieces'
 //! order, so that which thread ran a piece changes no bit. rayon enters the library here.
 //!
 //! Many tasks at once run on the same pool (the CLI's batches, `a2ml.plan_many`): a task's
@@ -9,33 +9,71 @@
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Mutex, PoisonError};
 
-use rayon::prelude::*;
-
-/// `f(i, &items[i])` for every item, on the pool, in the items' order.
+/// `f(i, &items[i])` for every item, side by side, in the items' order.
 pub(crate) fn map<T: Sync, R: Send>(items: &[T], f: impl Fn(usize, &T) -> R + Sync) -> Vec<R> {
-    items.par_iter().enumerate().map(|(i, item)| f(i, item)).collect()
+    in_turn(items.iter(), items.len(), f)
 }
 
-/// `f(i, &mut items[i])` for every item, on the pool, in the items' order.
+/// `f(i, &mut items[i])` for every item, side by side, in the items' order.
 pub(crate) fn map_mut<T: Send, R: Send>(
     items: &mut [T],
     f: impl Fn(usize, &mut T) -> R + Sync,
 ) -> Vec<R> {
-    items.par_iter_mut().enumerate().map(|(i, item)| f(i, item)).collect()
+    let count = items.len();
+    in_turn(items.iter_mut(), count, f)
 }
 
-/// `a()` and `b()`, side by side.
+/// `a()` and `b()`, side by side: `a` on this thread, `b` on the pool's.
 pub(crate) fn join<A: Send, B: Send>(
     a: impl FnOnce() -> A + Send,
     b: impl FnOnce() -> B + Send,
 ) -> (A, B) {
-    rayon::join(a, b)
+    let mut b_result = None;
+    let a_result = rayon::in_place_scope(|scope| {
+        scope.spawn(|_| b_result = Some(b()));
+        a()
+    });
+    // The scope returns once `b` has run, or passes on its panic.
+    (a_result, b_result.expect("the scope ran b"))
+}
+
+/// `f(i, item)` for each of the `count` items `items` gives, in the items' order: the
+/// calling thread and up to one thread of the pool per item more take the next item in
+/// turn when done with one. The caller works rather than waits (it may be the one thread
+/// a plan's critical path runs on), and a helper that comes late finds the items taken.
+fn in_turn<I, R>(items: I, count: usize, f: impl Fn(usize, I::Item) -> R + Sync) -> Vec<R>
+where
+    I: Iterator + Send,
+    I::Item: Send,
+    R: Send,
+{
+    let source = Mutex::new(items.enumerate());
+    let done = Mutex::new(Vec::with_capacity(count));
+    let take = || {
+        let mut mine = Vec::new();
+        loop {
+            let next = source.lock().unwrap_or_else(PoisonError::into_inner).next();
+            let Some((i, item)) = next else { break };
+            mine.push((i, f(i, item)));
+        }
+        done.lock().unwrap_or_else(PoisonError::into_inner).append(&mut mine);
+    };
+    let helpers = rayon::current_num_threads().min(count).saturating_sub(1);
+    rayon::in_place_scope(|scope| {
+        for _ in 0..helpers {
+            scope.spawn(|_| take());
+        }
+        take();
+    });
+    let mut done = done.into_inner().unwrap_or_else(PoisonError::into_inner);
+    done.sort_unstable_by_key(|&(i, _)| i);
+    done.into_iter().map(|(_, result)| result).collect()
 }
 
 /// `f(i, &items[i], abandoned)` for the items in turn until the first call that says its
-/// item is the last wanted (`(_, true)`): each of the pool's threads takes the lowest item
-/// not yet taken, so the items are begun in order, and none after the last wanted one is
-/// begun once it is known; `abandoned()` tells a call still running on a later item that
+/// item is the last wanted (`(_, true)`): the calling thread and the pool's take the lowest
+/// item not yet taken, so the items are begun in order, and none after the last wanted one
+/// is begun once it is known; `abandoned()` tells a call still running on a later item that
 /// its result will be thrown away, so that it may stop early. Returns the results of the
 /// items up to the last wanted one (every item's when none is), in order: the same as
 /// calling `f` on one item after the other and stopping after the last wanted one, so long
@@ -45,35 +83,22 @@ pub(crate) fn in_turn_until<T: Sync, R: Send>(
     items: &[T],
     f: impl Fn(usize, &T, &dyn Fn() -> bool) -> (R, bool) + Sync,
 ) -> Vec<R> {
-    let next = AtomicUsize::new(0);
     // The lowest item known to be the last wanted.
     let last = AtomicUsize::new(usize::MAX);
-    let results: Vec<Mutex<Option<R>>> = items.iter().map(|_| Mutex::new(None)).collect();
-    let take_in_turn = || {
-        loop {
-            let i = next.fetch_add(1, Ordering::Relaxed);
-            if i >= items.len() || i > last.load(Ordering::Relaxed) {
-                break;
-            }
-            let abandoned = || i > last.load(Ordering::Relaxed);
-            let (result, is_last) = f(i, &items[i], &abandoned);
-            if is_last {
-                last.fetch_min(i, Ordering::Relaxed);
-            }
-            *results[i].lock().unwrap_or_else(PoisonError::into_inner) = Some(result);
+    let results = map(items, |i, item| {
+        let abandoned = || i > last.load(Ordering::Relaxed);
+        if abandoned() {
+            return None;
         }
-    };
-    let threads = rayon::current_num_threads().min(items.len());
-    rayon::scope(|scope| {
-        for _ in 0..threads {
-            scope.spawn(|_| take_in_turn());
+        let (result, is_last) = f(i, item, &abandoned);
+        if is_last {
+            last.fetch_min(i, Ordering::Relaxed);
         }
+        Some(result)
     });
-    let wanted = last.into_inner().saturating_add(1).min(items.len());
+    let wanted = last.into_inner().saturating_add(1);
     // Every item up to the last wanted one was begun (in order) and none was abandoned.
-    (results.into_iter().take(wanted))
-        .map_while(|slot| slot.into_inner().unwrap_or_else(PoisonError::into_inner))
-        .collect()
+    results.into_iter().take(wanted).map_while(|result| result).collect()
 }
 
 #[cfg(test)]
