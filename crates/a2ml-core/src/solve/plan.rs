@@ -446,8 +446,7 @@ struct Piece {
 
 /// How much slower a solved segment must run to keep the rate `limits` on its own (1 when
 /// it keeps them): joining starts from this, so that the limit rounds only repair what
-/// joining changed. Measured as each segment is solved, beside the report thread's work on
-/// the one before, so that joining does not wait for the pool.
+/// joining changed.
 fn own_stretch(trajectory: &Trajectory, limits: &Limits) -> Real {
     let stretch = peaks(trajectory, trajectory.start(), trajectory.end()).stretch(limits);
     if stretch > 1.0 + LIMIT_TOLERANCE { stretch * (1.0 + 1e-6) } else { 1.0 }
@@ -565,7 +564,7 @@ impl<'a> Solver<'a> {
                 segment: k,
                 trajectory: solution.trajectory.clone(),
                 problem: job.problem.clone(),
-                stretch: own_stretch(&solution.trajectory, &self.limits),
+                stretch: 1.0,
                 start: 0.0,
                 swivel_map: solution.swivel_map.take(),
             });
@@ -588,6 +587,9 @@ impl<'a> Solver<'a> {
     /// it does, and the output checked again at every instant until it holds the limits (or
     /// the rounds run out). Returns the output and the notes on what was repaired.
     fn join_keeping_limits(&mut self) -> Result<(Trajectory, Vec<Warning>), SolveError> {
+        parallel::map_mut(&mut self.pieces, |_, piece| {
+            piece.stretch = own_stretch(&piece.trajectory, &self.limits);
+        });
         // The index of each action's first piece: a round rejoins from the first action it
         // slowed a piece of.
         let action_starts: Vec<usize> = (0..self.pieces.len())
