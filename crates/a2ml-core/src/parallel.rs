@@ -1,10 +1,12 @@
 //! Work shared out between the calling thread and the thread pool (rayon's global pool, or
 //! the pool a caller installs): one planned task's independent pieces, Opt1/Opt2's starts,
-//! a plan's segments, the output's samples. Each piece is computed alone and the results come back in the pieces'
-//! order, so that which thread ran a piece changes no bit. rayon enters the library here.
+//! a plan's segments, the output's samples. Each piece is computed alone and the results
+//! come back in the pieces' order, so that which thread ran a piece changes no bit. rayon
+//! enters the library here.
 //!
-//! Many tasks at once run on the same pool (the CLI's batches, `a2ml.plan_many`): a task's
-//! pieces then mostly run on its own thread, and nothing waits for a thread that is busy.
+//! The caller takes pieces itself and the pool's threads help as they come free. Many tasks
+//! at once run on the same pool (the CLI's batches, `a2ml.plan_many`): a task's pieces then
+//! mostly run on its own thread, and its helpers, found with nothing left, end at once.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Mutex, PoisonError};

@@ -362,7 +362,7 @@ impl Chart {
         std::array::from_fn(|k| {
             if !self.on_path[k] {
                 Some(0.0)
-            } else if self.references[k].bell().distance() == 0.0 {
+            } else if !self.moves(k) {
                 Some(self.error_of(state, k, self.references[k].at_fraction(0.0)))
             } else {
                 None

@@ -666,12 +666,11 @@ impl<'a> Solver<'a> {
         for (k, &first) in action_starts.iter().enumerate().skip(from) {
             let whole = joined.rewind(k);
             let mut notes = Vec::new();
-            let mut i = first;
-            let action = self.pieces[i].action;
+            let end = action_starts.get(k + 1).copied().unwrap_or(self.pieces.len());
             let action_start = whole.end().unwrap_or(0.0);
             let mut action_joined = Assembly::default();
             let mut last: Option<(Real, Real)> = None; // (start, duration) of the previous segment
-            while i < self.pieces.len() && self.pieces[i].action == action {
+            for i in first..end {
                 let segment = self.pieces[i].timed();
                 let duration = segment.duration();
                 let start = match last {
@@ -708,7 +707,6 @@ impl<'a> Solver<'a> {
                 };
                 last = Some((start, duration));
                 self.pieces[i].start = start;
-                i += 1;
             }
             if let Some(action_trajectory) = action_joined.finish()? {
                 whole.join_sequential(&action_trajectory)?;
